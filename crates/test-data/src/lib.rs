@@ -1,0 +1,61 @@
+//! Locates the real data in `../shared/data` for tests and benchmarks.
+//!
+//! The project's rule: a test that needs `../shared/data` (or a GPU adapter) **fails** when the
+//! `CI` environment variable is set, and **skips with a printed warning** otherwise, so that a
+//! user's fresh clone passes and CI tests everything.
+//!
+//! The data root is `$CLOTH_VIS_DATA` when set, else `<workspace>/../shared/data`.
+//!
+//! ```
+//! // In a test: returns None (after printing a warning) when the file is absent and CI is unset.
+//! if let Some(path) = test_data::shared_file("meshes/bun_zipper.ply") {
+//!     assert!(path.is_file());
+//! }
+//! ```
+
+use std::path::PathBuf;
+
+/// Environment variable that overrides the data root.
+pub const DATA_ENV: &str = "CLOTH_VIS_DATA";
+
+/// True when running under CI (`CI` set to anything but `""`, `0` or `false`).
+pub fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "0" && !v.eq_ignore_ascii_case("false"))
+}
+
+/// The root of the shared data, whether or not it exists.
+pub fn data_root() -> PathBuf {
+    if let Ok(dir) = std::env::var(DATA_ENV) {
+        return PathBuf::from(dir);
+    }
+    // crates/test-data -> workspace root -> ../shared/data
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data")
+}
+
+/// Path of `relative` under the shared data root if it exists.
+///
+/// # Panics
+/// When the path is missing and [`in_ci`] is true: CI must test everything.
+/// Otherwise a missing path prints a warning to stderr and returns `None`.
+#[track_caller]
+pub fn shared_file(relative: &str) -> Option<PathBuf> {
+    let path = data_root().join(relative);
+    if path.exists() {
+        return Some(path);
+    }
+    skip(&format!("shared data file {} not found", path.display()))
+}
+
+/// Report that a test cannot run for `reason` (missing data or GPU adapter).
+///
+/// # Panics
+/// When [`in_ci`] is true. Otherwise prints `SKIPPED: <caller>: <reason>` to stderr and returns `None`.
+#[track_caller]
+pub fn skip<T>(reason: &str) -> Option<T> {
+    let caller = std::panic::Location::caller();
+    if in_ci() {
+        panic!("{caller}: {reason} (CI is set, so this test must not be skipped)");
+    }
+    eprintln!("SKIPPED: {caller}: {reason} (set CI=1 to make this a failure)");
+    None
+}
