@@ -1,1 +1,36 @@
-//! wgpu adapter selection that works on any machine (hardware or Mesa lavapipe), and headless offscreen targets read back to PNG and EXR.
+//! GPU context for cloth-vis: one small helper that picks a wgpu adapter on any machine, and
+//! headless offscreen targets read back to linear HDR images saved as PNG or EXR.
+//!
+//! Every GPU entry point elsewhere in the workspace takes `&wgpu::Device` and `&wgpu::Queue`;
+//! acquiring them is this crate's only job. Adapter choice, in order:
+//!
+//! 1. the environment: `CLOTH_VIS_BACKEND` (or wgpu's own `WGPU_BACKEND`), a comma list of
+//!    `vulkan`, `gl`, `metal`, `dx12`, restricts the backends; `CLOTH_VIS_ADAPTER` (or
+//!    `WGPU_ADAPTER_NAME`) picks the adapter whose name contains the given text;
+//! 2. a hardware adapter (discrete, then integrated, then virtual);
+//! 3. a software adapter, e.g. Mesa's lavapipe (`apt-get install mesa-vulkan-drivers`), which is
+//!    what CI and machines without a GPU use.
+//!
+//! With no adapter at all, [`GpuContext::new`] returns [`GpuError::NoAdapter`], whose message
+//! says what to install.
+//!
+//! No seed section: this is infrastructure (DESIGN.md, "GPU").
+//!
+//! # Examples
+//!
+//! ```no_run
+//! use gpu_context::{GpuContext, GpuOptions};
+//! let ctx = GpuContext::new(&GpuOptions::default())?;
+//! println!("rendering on {}", ctx.summary());
+//! # Ok::<(), gpu_context::GpuError>(())
+//! ```
+
+mod adapter;
+mod error;
+mod image_out;
+mod offscreen;
+
+pub use adapter::{ADAPTER_ENV, AdapterSummary, BACKEND_ENV, GpuContext, GpuOptions};
+pub use error::GpuError;
+pub use image_out::{HdrImage, Tonemap};
+pub use offscreen::{COLOR_FORMAT, DEPTH_FORMAT, OffscreenTarget};

@@ -1,0 +1,209 @@
+//! Linear HDR images: tone mapping for display (exposure, gamma) and atomic PNG/EXR output.
+
+use std::path::{Path, PathBuf};
+
+use crate::GpuError;
+
+/// Display mapping: `display = clamp(exposure · linear)^(1/gamma)`, the seed's "standard gamma
+/// correction" (paper 000 §5) with an exposure multiplier in front.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tonemap {
+    /// Multiplier applied to linear radiance before clamping (1 = none).
+    pub exposure: f32,
+    /// Display gamma (2.2 by default; 1 = linear).
+    pub gamma: f32,
+}
+
+impl Default for Tonemap {
+    fn default() -> Self {
+        Self {
+            exposure: 1.0,
+            gamma: 2.2,
+        }
+    }
+}
+
+impl Tonemap {
+    /// Map one linear value to an 8-bit display value.
+    pub fn apply(&self, linear: f32) -> u8 {
+        let v = (linear * self.exposure).clamp(0.0, 1.0);
+        let v = if v.is_nan() { 0.0 } else { v };
+        (v.powf(1.0 / self.gamma) * 255.0 + 0.5) as u8
+    }
+}
+
+/// A linear RGBA image, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HdrImage {
+    width: u32,
+    height: u32,
+    pixels: Vec<[f32; 4]>,
+}
+
+impl HdrImage {
+    /// Wrap pixels.
+    ///
+    /// # Errors
+    /// [`GpuError::ImageSize`] when `pixels.len() != width · height`.
+    pub fn new(width: u32, height: u32, pixels: Vec<[f32; 4]>) -> Result<Self, GpuError> {
+        let expected = width as usize * height as usize;
+        if pixels.len() != expected {
+            return Err(GpuError::ImageSize {
+                width,
+                height,
+                expected,
+                actual: pixels.len(),
+            });
+        }
+        Ok(Self {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Pixels, row-major, top row first.
+    pub fn pixels(&self) -> &[[f32; 4]] {
+        &self.pixels
+    }
+
+    /// 8-bit RGBA for display (alpha clamped, not gamma-mapped).
+    pub fn to_rgba8(&self, tonemap: &Tonemap) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.pixels.len() * 4);
+        for p in &self.pixels {
+            out.extend_from_slice(&[
+                tonemap.apply(p[0]),
+                tonemap.apply(p[1]),
+                tonemap.apply(p[2]),
+                (p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8,
+            ]);
+        }
+        out
+    }
+
+    /// Write a tone-mapped 8-bit PNG. The file appears complete or not at all.
+    ///
+    /// # Errors
+    /// [`GpuError::Write`] naming the path.
+    pub fn write_png(&self, path: &Path, tonemap: &Tonemap) -> Result<(), GpuError> {
+        let rgba = self.to_rgba8(tonemap);
+        atomic_write(path, |tmp| {
+            image::save_buffer_with_format(
+                tmp,
+                &rgba,
+                self.width,
+                self.height,
+                image::ColorType::Rgba8,
+                image::ImageFormat::Png,
+            )
+            .map_err(|e| e.to_string())
+        })
+    }
+
+    /// Write a linear 32-bit float RGBA OpenEXR file. The file appears complete or not at all.
+    ///
+    /// # Errors
+    /// [`GpuError::Write`] naming the path.
+    pub fn write_exr(&self, path: &Path) -> Result<(), GpuError> {
+        let width = self.width as usize;
+        atomic_write(path, |tmp| {
+            exr::prelude::write_rgba_file(tmp, width, self.height as usize, |x, y| {
+                let p = self.pixels[y * width + x];
+                (p[0], p[1], p[2], p[3])
+            })
+            .map_err(|e| e.to_string())
+        })
+    }
+}
+
+/// Run `write` on a temporary path beside `path`, then rename it into place; on failure the
+/// temporary file is removed and nothing is left at `path`.
+fn atomic_write(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), GpuError> {
+    let fail = |reason: String| GpuError::Write {
+        path: path.to_owned(),
+        reason,
+    };
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| fail("not a file path".to_owned()))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(file_name);
+    tmp_name.push(format!(".{}.tmp", std::process::id()));
+    let tmp: PathBuf = path.with_file_name(tmp_name);
+    match write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string())) {
+        Ok(()) => Ok(()),
+        Err(reason) => {
+            let _ = std::fs::remove_file(&tmp);
+            Err(fail(reason))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tonemap_is_monotone_clamped_and_maps_one_to_white() {
+        let t = Tonemap::default();
+        assert_eq!(t.apply(0.0), 0);
+        assert_eq!(t.apply(1.0), 255);
+        assert_eq!(t.apply(1e9), 255);
+        assert_eq!(t.apply(f32::NAN), 0);
+        assert_eq!(t.apply(-1.0), 0);
+        // 0.5^(1/2.2) = 0.7297 -> 186
+        assert_eq!(t.apply(0.5), 186);
+        let brighter = Tonemap { exposure: 2.0, ..t };
+        assert_eq!(brighter.apply(0.5), 255);
+    }
+
+    #[test]
+    fn image_size_is_checked() {
+        assert!(matches!(
+            HdrImage::new(2, 2, vec![[0.0; 4]; 3]),
+            Err(GpuError::ImageSize {
+                expected: 4,
+                actual: 3,
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn exr_round_trips_and_failed_writes_leave_nothing() {
+        let dir = std::env::temp_dir().join(format!("gpu-context-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let pixels = (0..6).map(|i| [i as f32 * 10.5, -1.0, 1e4, 1.0]).collect();
+        let img = HdrImage::new(3, 2, pixels).unwrap();
+        let path = dir.join("x.exr");
+        img.write_exr(&path).unwrap();
+        let read = exr::prelude::read_first_rgba_layer_from_file(
+            &path,
+            |res, _| vec![[0.0f32; 4]; res.width() * res.height()],
+            |buf: &mut Vec<[f32; 4]>, pos, (r, g, b, a): (f32, f32, f32, f32)| {
+                buf[pos.y() * 3 + pos.x()] = [r, g, b, a];
+            },
+        )
+        .unwrap();
+        assert_eq!(read.layer_data.channel_data.pixels, img.pixels);
+        // A directory that does not exist: error names the path, no file left behind.
+        let bad = dir.join("missing-dir").join("y.png");
+        let err = img.write_png(&bad, &Tonemap::default()).unwrap_err();
+        assert!(err.to_string().contains("y.png"), "{err}");
+        assert!(!bad.exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
