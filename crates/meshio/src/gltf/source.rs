@@ -1,0 +1,228 @@
+//! Opening a glTF 2.0 file (`.gltf` JSON or `.glb` container): the document, validated, and
+//! its buffers (GLB `BIN` chunk, base64 `data:` URIs, or files beside the document).
+//!
+//! The `gltf` crate's own importer is not used: it also decodes every image (slow and not
+//! needed here), and it panics on some malformed input (an invalid percent-escape in a buffer
+//! URI; a `POSITION` accessor index out of range during validation), which must be errors.
+
+use std::path::{Path, PathBuf};
+
+use gltf::json::validation::Validate;
+
+use crate::MeshIoError;
+
+/// A parsed document and its buffer contents.
+pub(crate) struct GltfSource {
+    pub path: PathBuf,
+    pub document: gltf::Document,
+    pub buffers: Vec<Vec<u8>>,
+    pub is_glb: bool,
+}
+
+impl GltfSource {
+    /// An error about `element` of this file.
+    pub(crate) fn error(
+        &self,
+        element: impl Into<String>,
+        message: impl Into<String>,
+    ) -> MeshIoError {
+        gltf_error(&self.path, element, message)
+    }
+}
+
+pub(crate) fn gltf_error(
+    path: &Path,
+    element: impl Into<String>,
+    message: impl Into<String>,
+) -> MeshIoError {
+    MeshIoError::Gltf {
+        path: path.to_path_buf(),
+        element: element.into(),
+        message: message.into(),
+    }
+}
+
+/// Reads and validates `path` and loads its buffers.
+pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
+    let bytes = std::fs::read(path).map_err(|e| MeshIoError::io(path, "read", e))?;
+    let is_glb = bytes.starts_with(b"glTF");
+    let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| gltf_error(path, "file", format!("cannot parse: {e}; is it glTF 2.0?")))?;
+    validate(path, gltf.document.as_json())?;
+    let mut blob = gltf.blob;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut buffers = Vec::new();
+    for buffer in gltf.document.buffers() {
+        let element = format!("buffer {}", buffer.index());
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                gltf_error(
+                    path,
+                    &element,
+                    "refers to the GLB binary chunk, but there is none",
+                )
+            })?,
+            gltf::buffer::Source::Uri(uri) => read_uri(path, base, &element, uri)?,
+        };
+        if data.len() < buffer.length() {
+            return Err(gltf_error(
+                path,
+                element,
+                format!(
+                    "declares {} bytes but its data has {}; the file is truncated",
+                    buffer.length(),
+                    data.len()
+                ),
+            ));
+        }
+        buffers.push(data);
+    }
+    Ok(GltfSource {
+        path: path.to_path_buf(),
+        document: gltf.document,
+        buffers,
+        is_glb,
+    })
+}
+
+/// Runs the `gltf` crate's validation, after the checks that keep it from panicking.
+fn validate(path: &Path, root: &gltf::json::Root) -> Result<(), MeshIoError> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &primitive.attributes {
+                if index.value() >= root.accessors.len() {
+                    return Err(gltf_error(
+                        path,
+                        format!("mesh {m} primitive {p}"),
+                        format!(
+                            "attribute {semantic:?} refers to accessor {}, but there are {}",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    let mut problems = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |where_, error| {
+        problems.push(format!("{}: {error}", where_()));
+    });
+    if problems.is_empty() {
+        return Ok(());
+    }
+    let shown = problems
+        .iter()
+        .take(5)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join("; ");
+    Err(gltf_error(
+        path,
+        "document",
+        format!("{} validation problem(s): {shown}", problems.len()),
+    ))
+}
+
+/// Loads a buffer URI: a base64 `data:` URI or a path relative to the document.
+fn read_uri(path: &Path, base: &Path, element: &str, uri: &str) -> Result<Vec<u8>, MeshIoError> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let Some((_, payload)) = rest.split_once(";base64,") else {
+            return Err(gltf_error(
+                path,
+                element,
+                "data URI is not base64 (expected \"data:…;base64,…\")",
+            ));
+        };
+        return decode_base64(payload.as_bytes())
+            .ok_or_else(|| gltf_error(path, element, "data URI holds invalid base64"));
+    }
+    if uri.contains("://") {
+        return Err(gltf_error(
+            path,
+            element,
+            format!("URI {uri:?} is not a local file; download it first"),
+        ));
+    }
+    let relative = percent_decode(uri).ok_or_else(|| {
+        gltf_error(
+            path,
+            element,
+            format!("URI {uri:?} has an invalid %-escape"),
+        )
+    })?;
+    let file = base.join(relative);
+    std::fs::read(&file).map_err(|e| MeshIoError::io(&file, "read", e))
+}
+
+/// Decodes `%XX` escapes; `None` for a malformed escape or non-UTF-8 result.
+fn percent_decode(s: &str) -> Option<String> {
+    let bytes = s.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
+/// Decodes standard base64 (RFC 4648 alphabet, `=` padding optional, no whitespace).
+pub(crate) fn decode_base64(input: &[u8]) -> Option<Vec<u8>> {
+    fn sextet(c: u8) -> Option<u32> {
+        Some(match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' => 62,
+            b'/' => 63,
+            _ => return None,
+        } as u32)
+    }
+    let trimmed = input
+        .strip_suffix(b"==")
+        .or_else(|| input.strip_suffix(b"="))
+        .unwrap_or(input);
+    if trimmed.len() % 4 == 1 {
+        return None;
+    }
+    let mut out = Vec::with_capacity(trimmed.len() / 4 * 3 + 2);
+    for chunk in trimmed.chunks(4) {
+        let mut acc = 0u32;
+        for &c in chunk {
+            acc = (acc << 6) | sextet(c)?;
+        }
+        acc <<= 6 * (4 - chunk.len() as u32);
+        let bytes = acc.to_be_bytes();
+        out.extend_from_slice(&bytes[1..chunk.len()]);
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_round_trips_known_vectors() {
+        assert_eq!(decode_base64(b"").unwrap(), b"");
+        assert_eq!(decode_base64(b"Zg==").unwrap(), b"f");
+        assert_eq!(decode_base64(b"Zm8=").unwrap(), b"fo");
+        assert_eq!(decode_base64(b"Zm9v").unwrap(), b"foo");
+        assert_eq!(decode_base64(b"Zm9vYmFy").unwrap(), b"foobar");
+        assert!(decode_base64(b"Zm9v!").is_none());
+    }
+
+    #[test]
+    fn percent_escapes() {
+        assert_eq!(percent_decode("a%20b.bin").unwrap(), "a b.bin");
+        assert!(percent_decode("bad%FF").is_none());
+        assert!(percent_decode("cut%2").is_none());
+    }
+}

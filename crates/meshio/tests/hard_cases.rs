@@ -1,0 +1,700 @@
+//! Named adversarial inputs: each gives a clear error (never a panic) or a documented result.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{QUAD_VERTICES, assert_close, ply_ascii, ply_binary, write};
+use glam::Vec3;
+use meshio::{
+    AnimationOptions, DegenerateKind, LoadOptions, MeshIoError, NormalWeighting, compute_normals,
+    load_animation, load_mesh,
+};
+
+fn load(path: &Path) -> Result<(meshio::Mesh, meshio::LoadReport), MeshIoError> {
+    load_mesh(path, &LoadOptions::default())
+}
+
+// ---------------------------------------------------------------- non-finite coordinates
+
+#[test]
+fn nan_vertex_in_ascii_ply_names_vertex_component_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "nan.ply",
+        ply_ascii("0 0 0\n1 0 0\n0 nan 0\n", "3 0 1 2\n", 3, 1),
+    );
+    match load(&path) {
+        Err(MeshIoError::NonFinite {
+            element,
+            component: "y",
+            line: Some(12),
+            value,
+            ..
+        }) => {
+            assert_eq!(element, "vertex 2");
+            assert!(value.is_nan());
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn infinite_vertex_in_obj_and_binary_ply() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write(
+        dir.path(),
+        "inf.obj",
+        "v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n",
+    );
+    let err = load(&obj).unwrap_err();
+    assert!(
+        matches!(&err, MeshIoError::NonFinite { component: "z", line: Some(2), value, .. } if value.is_infinite()),
+        "{err}"
+    );
+    assert!(err.to_string().contains("vertex 1"), "{err}");
+    let ply = write(
+        dir.path(),
+        "inf.ply",
+        ply_binary(
+            false,
+            &[[0.0; 3], [f32::NEG_INFINITY, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            &[&[0, 1, 2]],
+        ),
+    );
+    assert!(matches!(
+        load(&ply),
+        Err(MeshIoError::NonFinite { component: "x", .. })
+    ));
+}
+
+#[test]
+fn nan_frame_in_npy_animation_names_frame_and_vertex() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("nan.npy");
+    let mut data = vec![0.0f32; 2 * 3 * 3];
+    data[3 * 3 + 2 * 3 + 1] = f32::NAN; // frame 1, vertex 2, y
+    meshio::write_npy_f32(&path, &[2, 3, 3], &data).unwrap();
+    match load_animation(&path, &AnimationOptions::default()) {
+        Err(MeshIoError::NonFinite {
+            element,
+            component: "y",
+            ..
+        }) => assert_eq!(element, "frame 1 vertex 2"),
+        other => panic!("{other:?}"),
+    }
+}
+
+// ---------------------------------------------------------------- index ranges
+
+#[test]
+fn out_of_range_ply_face_index_names_face_index_and_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "oor.ply",
+        ply_ascii(QUAD_VERTICES, "3 0 1 2\n3 0 2 4\n", 4, 2),
+    );
+    match load(&path) {
+        Err(MeshIoError::IndexOutOfRange {
+            element,
+            index: 4,
+            vertex_count: 4,
+            line: Some(15),
+            ..
+        }) => {
+            assert_eq!(element, "face 1");
+        }
+        other => panic!("{other:?}"),
+    }
+    let negative = write(
+        dir.path(),
+        "neg.ply",
+        ply_ascii(QUAD_VERTICES, "3 0 -1 2\n", 4, 1),
+    );
+    assert!(matches!(
+        load(&negative),
+        Err(MeshIoError::IndexOutOfRange { index: -1, .. })
+    ));
+}
+
+#[test]
+fn out_of_range_obj_indices_positive_negative_and_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    for (face, index) in [
+        ("f 1 2 4", 4),
+        ("f 1 2 -4", -4),
+        ("f 0 1 2", 0),
+        ("f 1/5 2/1 3/1", 5),
+    ] {
+        let text = format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\n{face}\n");
+        let path = write(dir.path(), "oor.obj", text);
+        match load(&path) {
+            Err(MeshIoError::IndexOutOfRange {
+                index: i,
+                line: Some(5),
+                ..
+            }) => assert_eq!(i, index, "{face}"),
+            other => panic!("{face}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn obj_negative_indices_and_forward_references_resolve() {
+    let dir = tempfile::tempdir().unwrap();
+    // The face refers to vertices defined after it (legal in practice) and relative ones.
+    let path = write(
+        dir.path(),
+        "rel.obj",
+        "f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf -3 -1 -2\n",
+    );
+    let (mesh, _) = load(&path).unwrap();
+    assert_eq!(mesh.triangles, vec![[0, 1, 2], [1, 3, 2]]);
+}
+
+// ---------------------------------------------------------------- empty meshes
+
+#[test]
+fn empty_meshes_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        ("empty.obj", String::new()),
+        ("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n".to_string()),
+        ("empty.ply", ply_ascii("", "", 0, 0)),
+        ("nofaces.ply", ply_ascii("0 0 0\n", "", 1, 0)),
+    ];
+    for (name, text) in cases {
+        let path = write(dir.path(), name, text);
+        assert!(
+            matches!(load(&path), Err(MeshIoError::EmptyMesh { .. })),
+            "{name}"
+        );
+    }
+    let empty_folder = dir.path().join("frames");
+    std::fs::create_dir(&empty_folder).unwrap();
+    assert!(matches!(
+        load_animation(&empty_folder, &AnimationOptions::default()),
+        Err(MeshIoError::FrameFolder { .. })
+    ));
+}
+
+// ---------------------------------------------------------------- huge or truncated counts
+
+#[test]
+fn huge_header_counts_fail_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let ascii = write(
+        dir.path(),
+        "huge.ply",
+        ply_ascii(QUAD_VERTICES, "3 0 1 2\n", 1 << 40, 1),
+    );
+    assert!(
+        matches!(load(&ascii), Err(MeshIoError::CountTooLarge { count, .. }) if count == 1 << 40)
+    );
+    let mut bin = ply_binary(false, &[[0.0; 3]; 3], &[&[0, 1, 2]]);
+    let text = String::from_utf8_lossy(&bin).replace("element face 1", "element face 99999999999");
+    bin = text.into_bytes();
+    let path = write(dir.path(), "hugefaces.ply", bin);
+    assert!(matches!(
+        load(&path),
+        Err(MeshIoError::CountTooLarge { .. })
+    ));
+    // u64 overflow of count × row size.
+    let overflow = write(
+        dir.path(),
+        "overflow.ply",
+        ply_ascii(QUAD_VERTICES, "", u64::MAX as usize, 0),
+    );
+    assert!(matches!(
+        load(&overflow),
+        Err(MeshIoError::CountTooLarge { .. })
+    ));
+    // A list length of 4 294 967 295 with little data behind it.
+    let mut list = ply_binary(false, &[[0.0; 3]; 3], &[]);
+    list = String::from_utf8_lossy(&list)
+        .replace(
+            "element face 0\nproperty list uchar int",
+            "element face 1\nproperty list uint int",
+        )
+        .into_bytes();
+    list.extend_from_slice(&u32::MAX.to_le_bytes());
+    list.extend_from_slice(&[0; 12]);
+    let path = write(dir.path(), "hugelist.ply", list);
+    assert!(matches!(
+        load(&path),
+        Err(MeshIoError::Truncated {
+            bytes_needed: 17_179_869_180,
+            ..
+        })
+    ));
+    // .npy claiming 2^40 values.
+    let dict = b"{'descr': '<f4', 'fortran_order': False, 'shape': (1099511627776, 3), }\n";
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&(dict.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(dict);
+    bytes.extend_from_slice(&[0; 24]);
+    let npy = write(dir.path(), "huge.npy", bytes);
+    assert!(matches!(
+        meshio::read_npy_f32(&npy),
+        Err(MeshIoError::Npy { .. })
+    ));
+}
+
+#[test]
+fn empty_elements_with_huge_counts_are_harmless() {
+    // An element without properties occupies no bytes, whatever its count.
+    let dir = tempfile::tempdir().unwrap();
+    let text = ply_ascii(QUAD_VERTICES, "3 0 1 2\n", 4, 1)
+        .replace("end_header", "element nothing 1099511627776\nend_header");
+    let (mesh, report) = load(&write(dir.path(), "nothing.ply", text)).unwrap();
+    assert_eq!(mesh.triangle_count(), 1);
+    assert!(
+        report
+            .skipped_properties
+            .iter()
+            .any(|p| p.starts_with("element nothing"))
+    );
+}
+
+#[test]
+fn truncated_binary_ply_names_offset_and_length() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = ply_binary(
+        false,
+        &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[&[0, 1, 2], &[2, 1, 0]],
+    );
+    let cut = &full[..full.len() - 3];
+    let path = write(dir.path(), "cut.ply", cut);
+    match load(&path) {
+        Err(MeshIoError::Truncated {
+            element, file_len, ..
+        }) => {
+            assert!(element.starts_with("face 1"), "{element}");
+            assert_eq!(file_len, cut.len() as u64);
+        }
+        other => panic!("{other:?}"),
+    }
+    // Cut inside the vertex block: caught by the header size check.
+    let path = write(dir.path(), "cut2.ply", &full[..full.len() - 30]);
+    assert!(matches!(
+        load(&path),
+        Err(MeshIoError::CountTooLarge { .. } | MeshIoError::Truncated { .. })
+    ));
+}
+
+#[test]
+fn truncated_ascii_ply_names_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "cut.ply",
+        ply_ascii(QUAD_VERTICES, "3 0 1 2\n3 0 2", 4, 2),
+    );
+    assert!(
+        matches!(
+            load(&path),
+            Err(MeshIoError::UnexpectedEof { line: Some(15), .. })
+        ),
+        "{:?}",
+        load(&path)
+    );
+}
+
+// ---------------------------------------------------------------- malformed text
+
+#[test]
+fn malformed_numbers_name_the_line_and_token() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write(
+        dir.path(),
+        "bad.obj",
+        "v 0 0 0\nv 1 0 0\nv 1.0 abc 2\nf 1 2 3\n",
+    );
+    match load(&obj) {
+        Err(MeshIoError::Malformed {
+            line: Some(3),
+            token,
+            ..
+        }) => assert_eq!(token, "abc"),
+        other => panic!("{other:?}"),
+    }
+    let ply = write(
+        dir.path(),
+        "bad.ply",
+        ply_ascii("0 0 0\n1 0 0\n0 1 zero\n", "3 0 1 2\n", 3, 1),
+    );
+    assert!(matches!(
+        load(&ply),
+        Err(MeshIoError::Malformed { line: Some(12), .. })
+    ));
+    let face = write(
+        dir.path(),
+        "badface.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/1/1/1\n",
+    );
+    assert!(matches!(
+        load(&face),
+        Err(MeshIoError::Malformed { line: Some(4), .. })
+    ));
+    let short = write(dir.path(), "short.obj", "v 0 0 0\nv 1 0 0\nf 1 2\n");
+    assert!(matches!(
+        load(&short),
+        Err(MeshIoError::ShortFace {
+            corners: 2,
+            line: Some(3),
+            ..
+        })
+    ));
+}
+
+#[test]
+fn malformed_ply_headers() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = ply_ascii(QUAD_VERTICES, "3 0 1 2\n", 4, 1);
+    let cases = [
+        ("magic", good.replacen("ply", "plx", 1)),
+        (
+            "format",
+            good.replace("format ascii 1.0", "format utf8 1.0"),
+        ),
+        ("no end", good.replace("end_header", "end_headr")),
+        (
+            "float list count",
+            good.replace("list uchar int", "list float int"),
+        ),
+        (
+            "float index items",
+            good.replace("list uchar int", "list uchar float"),
+        ),
+        (
+            "property first",
+            good.replace("element vertex 4\n", "").replacen(
+                "property float x\n",
+                "property float x\nelement vertex 4\n",
+                1,
+            ),
+        ),
+        ("missing z", good.replace("property float z\n", "")),
+        (
+            "duplicate element",
+            good.replace("end_header", "element vertex 1\nend_header"),
+        ),
+    ];
+    for (name, text) in cases {
+        let path = write(dir.path(), "h.ply", text);
+        assert!(
+            matches!(load(&path), Err(MeshIoError::InvalidHeader { .. })),
+            "{name}: {:?}",
+            load(&path)
+        );
+    }
+}
+
+#[test]
+fn unsupported_extension() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(dir.path(), "mesh.stl", "solid");
+    assert!(
+        matches!(load(&path), Err(MeshIoError::UnsupportedFormat { extension, .. }) if extension == "stl")
+    );
+}
+
+// ---------------------------------------------------------------- degenerate, duplicate, unreferenced
+
+#[test]
+fn degenerate_and_zero_area_triangles_are_reported_and_removed_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    // v4 duplicates v1's position; v5 lies on the segment v0-v1.
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 1 0 0\nv 0.5 0 0\n\
+                f 1 2 3\nf 1 1 2\nf 2 5 3\nf 1 6 2\nf 2 4 3\n";
+    let path = write(dir.path(), "degenerate.obj", text);
+    let (mesh, report) = load(&path).unwrap();
+    assert_eq!(mesh.triangle_count(), 5);
+    let kinds: Vec<(u32, DegenerateKind)> = report
+        .degenerate_triangles
+        .iter()
+        .map(|d| (d.triangle, d.kind))
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![
+            (1, DegenerateKind::RepeatedIndex),
+            (2, DegenerateKind::ZeroArea),
+            (3, DegenerateKind::ZeroArea)
+        ]
+    );
+    assert_eq!(report.duplicate_positions, 1);
+    // v5 is only in a degenerate triangle: its normal is exactly zero (documented fallback).
+    assert_eq!(mesh.normals[5], Vec3::ZERO);
+    let options = LoadOptions {
+        remove_degenerate: true,
+        remove_unreferenced: true,
+        ..LoadOptions::default()
+    };
+    let (clean, report) = load_mesh(&path, &options).unwrap();
+    assert_eq!(clean.triangles.len(), 2);
+    assert_eq!(report.removed_triangles, 3);
+    // v4 and v5 were referenced only by degenerate triangles.
+    assert_eq!(report.unreferenced_vertices, vec![4, 5]);
+    assert_eq!(clean.vertex_count(), 4);
+    assert!(clean.normals.iter().all(|n| (*n - Vec3::Z).length() < 1e-6));
+}
+
+#[test]
+fn only_degenerate_triangles_left_is_an_error_after_removal() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "line.obj",
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+    );
+    let (mesh, report) = load(&path).unwrap();
+    assert_eq!(report.degenerate_triangles.len(), 1);
+    assert!(mesh.normals.iter().all(|n| *n == Vec3::ZERO));
+    let options = LoadOptions {
+        remove_degenerate: true,
+        ..LoadOptions::default()
+    };
+    assert!(matches!(
+        load_mesh(&path, &options),
+        Err(MeshIoError::EmptyMesh { .. })
+    ));
+}
+
+#[test]
+fn duplicate_positions_count_signed_zeros_as_equal() {
+    let positions = [
+        Vec3::ZERO,
+        Vec3::new(-0.0, 0.0, -0.0),
+        Vec3::X,
+        Vec3::X,
+        Vec3::X,
+    ];
+    assert_eq!(meshio::count_duplicate_positions(&positions), 3);
+}
+
+#[test]
+fn unreferenced_vertices_are_kept_in_place_by_default_and_remapped_on_request() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "unref.obj",
+        "v 9 9 9\nv 0 0 0\nv 8 8 8\nv 1 0 0\nv 0 1 0\nf 2 4 5\n",
+    );
+    let (mesh, report) = load(&path).unwrap();
+    assert_eq!(mesh.vertex_count(), 5);
+    assert_eq!(report.unreferenced_vertices, vec![0, 2]);
+    assert_eq!(mesh.positions[2], Vec3::splat(8.0));
+    let options = LoadOptions {
+        remove_unreferenced: true,
+        ..LoadOptions::default()
+    };
+    let (mesh, report) = load_mesh(&path, &options).unwrap();
+    assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+    assert_eq!(
+        report.vertex_remap,
+        Some(vec![None, Some(0), None, Some(1), Some(2)])
+    );
+}
+
+// ---------------------------------------------------------------- strips and polygons
+
+fn strip_ply(dir: &Path, strip: &[i32]) -> PathBuf {
+    let header = format!(
+        "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\n\
+         element tristrips 1\nproperty list int int vertex_indices\nend_header\n\
+         0 0 0\n0 1 0\n1 0 0\n1 1 0\n2 0 0\n2 1 0\n{} {}\n",
+        strip.len(),
+        strip
+            .iter()
+            .map(i32::to_string)
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    write(dir, "strip.ply", header)
+}
+
+#[test]
+fn strip_restarts_at_start_end_and_consecutive() {
+    let dir = tempfile::tempdir().unwrap();
+    // Vertices zig-zag along x: 0 2 4 at y = 0, 1 3 5 at y = 1.
+    let continuous = load(&strip_ply(dir.path(), &[0, 1, 2, 3, 4, 5])).unwrap().0;
+    assert_eq!(
+        continuous.triangles,
+        vec![[0, 1, 2], [2, 1, 3], [2, 3, 4], [4, 3, 5]]
+    );
+    let restarted = load(&strip_ply(
+        dir.path(),
+        &[-1, -1, 0, 1, 2, 3, -1, -1, 2, 3, 4, 5, -1],
+    ))
+    .unwrap()
+    .0;
+    assert_eq!(
+        restarted.triangles,
+        vec![[0, 1, 2], [2, 1, 3], [2, 3, 4], [4, 3, 5]]
+    );
+    // All triangles face the same way (alternating winding): normals are all -z here.
+    for n in compute_normals(
+        &restarted.positions,
+        &restarted.triangles,
+        NormalWeighting::Area,
+    ) {
+        assert_close(n, -Vec3::Z, 1e-6);
+    }
+    let bad = strip_ply(dir.path(), &[0, 1, -2, 3]);
+    assert!(matches!(
+        load(&bad),
+        Err(MeshIoError::IndexOutOfRange { index: -2, .. })
+    ));
+}
+
+#[test]
+fn mixed_polygon_sizes_are_fan_triangulated() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = write(
+        dir.path(),
+        "mixed.obj",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv -1 0.5 0\nf 1 2 3\nf 1 2 3 4\nf 1 2 3 4 5\n",
+    );
+    let (mesh, report) = load(&obj).unwrap();
+    assert_eq!(
+        mesh.triangles,
+        vec![
+            [0, 1, 2],
+            [0, 1, 2],
+            [0, 2, 3],
+            [0, 1, 2],
+            [0, 2, 3],
+            [0, 3, 4]
+        ]
+    );
+    assert_eq!(report.polygons_triangulated, 2);
+    assert_eq!(report.file_face_count, 3);
+    let ply = write(
+        dir.path(),
+        "mixed.ply",
+        ply_ascii(
+            "0 0 0\n1 0 0\n1 1 0\n0 1 0\n-1 0.5 0\n",
+            "3 0 1 2\n4 0 1 2 3\n5 0 1 2 3 4\n",
+            5,
+            3,
+        ),
+    );
+    assert_eq!(load(&ply).unwrap().0.triangles, mesh.triangles);
+}
+
+// ---------------------------------------------------------------- line endings and encodings
+
+#[test]
+fn crlf_line_endings_and_missing_trailing_newline() {
+    let dir = tempfile::tempdir().unwrap();
+    let unix = write(
+        dir.path(),
+        "unix.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let crlf = write(
+        dir.path(),
+        "crlf.obj",
+        "v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n",
+    );
+    let no_newline = write(dir.path(), "nonl.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3");
+    let reference = load(&unix).unwrap().0;
+    assert_eq!(load(&crlf).unwrap().0, reference);
+    assert_eq!(load(&no_newline).unwrap().0, reference);
+    let ply = ply_ascii("0 0 0\n1 0 0\n0 1 0\n", "3 0 1 2", 3, 1);
+    let ply_crlf = write(dir.path(), "crlf.ply", ply.replace('\n', "\r\n"));
+    let ply_nonl = write(dir.path(), "nonl.ply", ply);
+    assert_eq!(load(&ply_crlf).unwrap().0, reference);
+    assert_eq!(load(&ply_nonl).unwrap().0, reference);
+}
+
+// ---------------------------------------------------------------- glTF
+
+fn gltf(dir: &Path, doc: serde_json::Value) -> PathBuf {
+    write(dir, "bad.gltf", serde_json::to_vec(&doc).unwrap())
+}
+
+#[test]
+fn corrupt_gltf_files_are_errors_not_panics() {
+    let dir = tempfile::tempdir().unwrap();
+    let positions = common::base64(&[0u8; 36]);
+    let base = |accessor: serde_json::Value, uri: String| {
+        serde_json::json!({
+            "asset": {"version": "2.0"},
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "buffers": [{"byteLength": 36, "uri": uri}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}],
+            "accessors": [accessor],
+        })
+    };
+    let good = serde_json::json!({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]});
+    let data_uri = format!("data:application/octet-stream;base64,{positions}");
+    // Sanity: the good file loads (one degenerate triangle at the origin).
+    assert!(load(&gltf(dir.path(), base(good.clone(), data_uri.clone()))).is_ok());
+    let mut too_many = good.clone();
+    too_many["count"] = serde_json::json!(1_000_000_000u64);
+    let mut bad_offset = good.clone();
+    bad_offset["byteOffset"] = serde_json::json!(4_000_000_000u64);
+    let mut vec2 = good.clone();
+    vec2["type"] = serde_json::json!("VEC2");
+    let cases = [
+        ("count beyond view", base(too_many, data_uri.clone())),
+        ("offset beyond view", base(bad_offset, data_uri.clone())),
+        ("wrong type", base(vec2, data_uri.clone())),
+        (
+            "bad base64",
+            base(
+                good.clone(),
+                "data:application/octet-stream;base64,@@@@".into(),
+            ),
+        ),
+        ("bad percent escape", base(good.clone(), "a%FF.bin".into())),
+        ("missing file", base(good.clone(), "missing.bin".into())),
+        (
+            "short buffer",
+            base(
+                good.clone(),
+                format!(
+                    "data:application/octet-stream;base64,{}",
+                    common::base64(&[0u8; 8])
+                ),
+            ),
+        ),
+    ];
+    for (name, doc) in cases {
+        let result = load(&gltf(dir.path(), doc));
+        assert!(result.is_err(), "{name}: {result:?}");
+    }
+    let mut no_accessor = base(good.clone(), data_uri.clone());
+    no_accessor["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = serde_json::json!(7);
+    assert!(matches!(
+        load(&gltf(dir.path(), no_accessor)),
+        Err(MeshIoError::Gltf { .. })
+    ));
+    let mut cycle = base(good.clone(), data_uri.clone());
+    cycle["nodes"] = serde_json::json!([{"mesh": 0, "children": [1]}, {"children": [0]}]);
+    assert!(matches!(
+        load(&gltf(dir.path(), cycle)),
+        Err(MeshIoError::Gltf { .. })
+    ));
+    let truncated_glb = write(
+        dir.path(),
+        "cut.glb",
+        b"glTF\x02\x00\x00\x00\xff\x00\x00\x00",
+    );
+    assert!(matches!(
+        load(&truncated_glb),
+        Err(MeshIoError::Gltf { .. })
+    ));
+    let no_scene_mesh = serde_json::json!({"asset": {"version": "2.0"}, "scenes": [{"nodes": []}]});
+    assert!(matches!(
+        load(&gltf(dir.path(), no_scene_mesh)),
+        Err(MeshIoError::EmptyMesh { .. })
+    ));
+}
