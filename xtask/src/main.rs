@@ -1,1 +1,53 @@
-fn main() {}
+//! `cargo xtask …`: reproduction scripts that write reports under `target/repro/`.
+//!
+//! - `cargo xtask repro lightsphere`: what each lightsphere level and I_j method costs in time
+//!   and buys in accuracy, on every HDR map in `../shared/data/env` and the procedural sky
+//!   (`target/repro/lightsphere.md` and `lightsphere.svg`).
+
+mod plot;
+mod repro_lightsphere;
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "xtask", about = "cloth-vis reproduction scripts")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Reproduce a figure or table as a markdown report and a plot under target/repro/.
+    Repro {
+        #[command(subcommand)]
+        what: Repro,
+    },
+}
+
+#[derive(Subcommand)]
+enum Repro {
+    /// Lightsphere levels × I_j methods: power error, irradiance error, time.
+    Lightsphere {
+        /// Highest level to evaluate.
+        #[arg(long, default_value_t = 6)]
+        max_level: u32,
+    },
+}
+
+/// `target/repro` of the workspace.
+fn repro_dir() -> anyhow::Result<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/repro");
+    std::fs::create_dir_all(&dir)?;
+    Ok(dir)
+}
+
+fn main() -> anyhow::Result<()> {
+    match Cli::parse().command {
+        Command::Repro {
+            what: Repro::Lightsphere { max_level },
+        } => repro_lightsphere::run(&repro_dir()?, max_level),
+    }
+}

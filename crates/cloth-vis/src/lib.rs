@@ -1,1 +1,53 @@
-//! cloth-vis facade: scene files, the effect graph that builds only the stages a scene asks for, file IO, the CLI and the demo.
+//! # cloth-vis
+//!
+//! The facade of the cloth-vis workspace: scene files, the effect graph that builds only the
+//! stages a scene asks for, file input through `meshio`, the wgpu renderer, the CLI
+//! (`cloth-vis render SCENE.toml --out DIR`, `cloth-vis demo --out DIR`, `cloth-vis inspect`)
+//! and the demo.
+//!
+//! It implements the rendering side of paper 000 (thesis §4.4): per-vertex colours
+//! c_i = Σ_j M_ij I_j from a lightsphere of directions l_j with environment radiance I_j
+//! (§3.3, §3.4, §5), Gouraud-interpolated, with exposure and gamma for display. Until the
+//! occlusion-gpu crate lands, M_ij = max(0, n_i·l_j) (no visibility); see [`lighting`].
+//!
+//! Domain crates never depend on this one; it only ties them together.
+//!
+//! # Examples
+//!
+//! Plan a scene without running it — a scene that does not ask for `lighting` never builds the
+//! light-direction or lighting stages:
+//!
+//! ```
+//! use cloth_vis::{Plan, Scene, Stage};
+//! let scene = Scene::from_toml(
+//!     r#"
+//!     [[object]]
+//!     name = "cloth"
+//!     source = "synth:cloth"
+//!     "#,
+//!     std::path::Path::new("."),
+//!     "example",
+//! )?;
+//! let plan = Plan::for_scene(&scene)?;
+//! assert_eq!(plan.stages(), &[Stage::Geometry, Stage::Render]);
+//! # Ok::<(), cloth_vis::Error>(())
+//! ```
+
+pub mod camera;
+pub mod demo;
+pub mod effects;
+mod error;
+pub mod lighting;
+pub mod plan;
+pub mod render;
+pub mod report;
+pub mod run;
+pub mod scene;
+
+pub use demo::{DEMO_SCENE, demo_scene, run_demo};
+pub use effects::Effect;
+pub use error::Error;
+pub use plan::{Plan, Stage};
+pub use report::RunReport;
+pub use run::{RunOptions, RunOutput, run_scene};
+pub use scene::Scene;

@@ -1,0 +1,61 @@
+//! The facade's error type.
+
+use std::path::PathBuf;
+
+/// Everything a scene run can fail with. Messages name the file, the element and the value.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The scene text is malformed or a value is out of range.
+    #[error("scene {origin}: {message}")]
+    Scene {
+        /// Scene file (or `embedded demo scene`).
+        origin: String,
+        /// What is wrong, with the key and value.
+        message: String,
+    },
+    /// The scene asks for an effect this build does not contain yet.
+    #[error(
+        "scene {origin}: effect \"{effect}\" is not built yet (it arrives with the `{provider}` \
+         crate); remove it from `effects` to render without it"
+    )]
+    EffectNotBuilt {
+        /// Scene file.
+        origin: String,
+        /// The effect's scene-file name.
+        effect: &'static str,
+        /// The crate that will provide it.
+        provider: &'static str,
+    },
+    /// Reading or writing a file failed.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+    /// A mesh or animation could not be loaded.
+    #[error(transparent)]
+    Mesh(#[from] meshio::MeshIoError),
+    /// An environment or lightsphere problem.
+    #[error(transparent)]
+    Light(#[from] lightsphere::LightsphereError),
+    /// Procedural data could not be made.
+    #[error(transparent)]
+    Synth(#[from] synth::SynthError),
+    /// GPU acquisition, rendering or image output failed.
+    #[error(transparent)]
+    Gpu(#[from] gpu_context::GpuError),
+    /// An object's frame index is outside its animation.
+    #[error(
+        "object {object}: frame {frame} is outside the animation's {count} frames (use 0..{count} or -1 for the last)"
+    )]
+    Frame {
+        /// Object name.
+        object: String,
+        /// Requested frame.
+        frame: i64,
+        /// Frames available.
+        count: usize,
+    },
+}

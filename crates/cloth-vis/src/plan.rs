@@ -1,0 +1,99 @@
+//! The effect graph: from a scene's effects to the ordered stages that must run — and no others.
+//!
+//! | stage | runs when |
+//! |---|---|
+//! | `geometry` | always (meshes, animation frames, procedural cloth) |
+//! | `environment` | `lighting` is requested, or an environment is drawn as the backdrop |
+//! | `light-directions` | `lighting` (lightsphere level, I_j per direction) |
+//! | `lighting` | `lighting` (per-vertex radiance) |
+//! | `render` | always (PNG/EXR) |
+//!
+//! Later effects (self-shadowing, BTF, shadow volumes, translucency) add their own stages here
+//! without touching the others.
+
+use serde::Serialize;
+
+use crate::scene::{BackgroundDesc, Scene};
+use crate::{Effect, Error};
+
+/// A unit of work in a run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Stage {
+    /// Load or generate every object's geometry.
+    Geometry,
+    /// Load or generate the HDR environment (rotation, prefilter).
+    Environment,
+    /// Build the lightsphere and sample I_j per direction.
+    LightDirections,
+    /// Per-vertex image-based radiance.
+    Lighting,
+    /// Rasterise and write images.
+    Render,
+}
+
+impl Stage {
+    /// The stage's name in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stage::Geometry => "geometry",
+            Stage::Environment => "environment",
+            Stage::LightDirections => "light-directions",
+            Stage::Lighting => "lighting",
+            Stage::Render => "render",
+        }
+    }
+
+    /// Stages an effect needs (beyond geometry and render, which always run).
+    pub fn needed_by(effect: Effect) -> &'static [Stage] {
+        match effect {
+            Effect::Lighting => &[Stage::Environment, Stage::LightDirections, Stage::Lighting],
+            // Not built yet: validation rejects them before planning.
+            Effect::SelfShadowing | Effect::Btf | Effect::ShadowVolumes | Effect::Translucency => {
+                &[]
+            }
+        }
+    }
+}
+
+/// The validated effects of a scene and the stages that will run, in order.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Plan {
+    effects: Vec<Effect>,
+    stages: Vec<Stage>,
+}
+
+impl Plan {
+    /// Validate the scene and plan its stages. Nothing is loaded or computed.
+    ///
+    /// # Errors
+    /// Every error of [`Scene::validate`]: unknown or unbuilt effects, bad values, missing files.
+    pub fn for_scene(scene: &Scene) -> Result<Self, Error> {
+        let effects = scene.validate()?;
+        let mut stages = vec![Stage::Geometry, Stage::Render];
+        for effect in &effects {
+            stages.extend_from_slice(Stage::needed_by(*effect));
+        }
+        if scene.environment.is_some() && scene.output.background == BackgroundDesc::Environment {
+            stages.push(Stage::Environment);
+        }
+        stages.sort();
+        stages.dedup();
+        Ok(Self { effects, stages })
+    }
+
+    /// The requested effects, in stage order.
+    pub fn effects(&self) -> &[Effect] {
+        &self.effects
+    }
+
+    /// The stages that will run, in order.
+    pub fn stages(&self) -> &[Stage] {
+        &self.stages
+    }
+
+    /// Whether `stage` will run.
+    pub fn contains(&self, stage: Stage) -> bool {
+        self.stages.contains(&stage)
+    }
+}

@@ -1,0 +1,592 @@
+//! Scene files (TOML): inputs, transforms, environment, camera, materials and the effects wanted.
+//!
+//! ```toml
+//! name = "drape"
+//! effects = ["lighting"]
+//!
+//! [[object]]
+//! name = "cloth"
+//! source = "synth:cloth"        # or a mesh (.ply .obj .gltf .glb) or an animation
+//! frame = -1                    # animation frame; negative counts from the end
+//! albedo = [0.75, 0.2, 0.15]
+//! two_sided = true
+//!
+//! [environment]
+//! source = "synth:sky"          # or an equirectangular .hdr / .exr
+//! rotation_deg = 30.0           # about +Y
+//!
+//! [lighting]
+//! level = 3
+//!
+//! [camera]
+//! width = 768
+//! height = 768
+//! ```
+//!
+//! Relative paths are resolved against the scene file's folder. [`Scene::validate`] checks every
+//! name, range and file before any work starts; its errors name the scene file, the key and the
+//! value.
+
+use std::path::{Path, PathBuf};
+
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use serde::Deserialize;
+
+use crate::{Effect, Error};
+
+/// Prefix of procedural sources in scene files.
+pub const SYNTH_PREFIX: &str = "synth:";
+/// Largest lightsphere level a scene may ask for (k = 2 + 4^8 = 65,538 directions).
+pub const MAX_LEVEL: u32 = 7;
+/// Largest image side a scene may ask for.
+pub const MAX_IMAGE_SIDE: u32 = 8192;
+
+/// A parsed scene file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Name used in reports.
+    #[serde(default = "default_name")]
+    pub name: String,
+    /// Effects wanted, by name (see [`Effect`]).
+    #[serde(default)]
+    pub effects: Vec<String>,
+    /// Objects to render (at least one).
+    #[serde(rename = "object", default)]
+    pub objects: Vec<ObjectDesc>,
+    /// The HDR environment; required by `lighting`.
+    pub environment: Option<EnvironmentDesc>,
+    /// Lighting parameters.
+    #[serde(default)]
+    pub lighting: LightingDesc,
+    /// Procedural data parameters (for `synth:` sources).
+    #[serde(default)]
+    pub synth: SynthDesc,
+    /// The camera; framed automatically where fields are omitted.
+    #[serde(default)]
+    pub camera: CameraDesc,
+    /// Image outputs.
+    #[serde(default)]
+    pub output: OutputDesc,
+    /// Folder that relative paths are resolved against (the scene file's folder).
+    #[serde(skip)]
+    pub base_dir: PathBuf,
+    /// Where the scene came from, for error messages.
+    #[serde(skip)]
+    pub origin: String,
+}
+
+fn default_name() -> String {
+    "scene".to_owned()
+}
+
+/// One object: a mesh or one frame of an animation, with a transform and a material.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    /// Name used in reports.
+    pub name: String,
+    /// `synth:cloth`, `synth:cloth-obstacle`, or a path to a mesh or animation.
+    pub source: String,
+    /// Animation frame to show; negative counts from the end (-1 = last).
+    #[serde(default)]
+    pub frame: i64,
+    /// Diffuse albedo ρ (linear RGB, each in [0, 1]).
+    #[serde(default = "default_albedo")]
+    pub albedo: [f32; 3],
+    /// Light both sides (cloth); the back side uses the flipped normal.
+    #[serde(default)]
+    pub two_sided: bool,
+    /// Translation (world units).
+    #[serde(default)]
+    pub translation: [f32; 3],
+    /// Rotation as XYZ Euler angles in degrees.
+    #[serde(default)]
+    pub rotation_deg: [f32; 3],
+    /// Uniform scale.
+    #[serde(default = "one")]
+    pub scale: f32,
+}
+
+fn default_albedo() -> [f32; 3] {
+    [0.7, 0.7, 0.7]
+}
+fn one() -> f32 {
+    1.0
+}
+
+impl ObjectDesc {
+    /// `world_from_object` of this object.
+    pub fn world_from_object(&self) -> Mat4 {
+        let [rx, ry, rz] = self.rotation_deg.map(f32::to_radians);
+        Mat4::from_scale_rotation_translation(
+            Vec3::splat(self.scale),
+            Quat::from_euler(EulerRot::XYZ, rx, ry, rz),
+            Vec3::from(self.translation),
+        )
+    }
+}
+
+/// The HDR environment.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    /// `synth:sky` or a path to an equirectangular `.hdr` / `.exr`.
+    pub source: String,
+    /// Rotation of the environment about +Y relative to the world, in degrees.
+    #[serde(default)]
+    pub rotation_deg: f32,
+    /// Spherical Gaussian prefilter σ in degrees (0 = none).
+    #[serde(default)]
+    pub prefilter_sigma_deg: f64,
+}
+
+/// How I_j is computed for each light direction.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RadianceMethodDesc {
+    /// Mean radiance over each direction's Voronoi cell (exact power; the default).
+    #[default]
+    CellMean,
+    /// Look-up of the prefiltered map at l_j, as published (paper 000 §5).
+    PrefilteredLookup,
+}
+
+/// Lighting parameters.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightingDesc {
+    /// Lightsphere subdivision level s (k = 2 + 4^(s+1) directions).
+    #[serde(default = "default_level")]
+    pub level: u32,
+    /// How I_j is computed.
+    #[serde(default)]
+    pub method: RadianceMethodDesc,
+}
+
+fn default_level() -> u32 {
+    3
+}
+
+impl Default for LightingDesc {
+    fn default() -> Self {
+        Self {
+            level: default_level(),
+            method: RadianceMethodDesc::default(),
+        }
+    }
+}
+
+/// Parameters of procedural sources.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SynthDesc {
+    /// Cloth grid side (vertices per side; ≥ 2).
+    pub cloth_grid: Option<usize>,
+    /// Simulated frames.
+    pub cloth_frames: Option<usize>,
+    /// Seed of the cloth simulation.
+    #[serde(default)]
+    pub seed: u64,
+    /// Sun elevation above the horizon, degrees.
+    pub sun_elevation_deg: Option<f32>,
+    /// Sun azimuth, degrees.
+    pub sun_azimuth_deg: Option<f32>,
+    /// Sky map width (height is half).
+    pub sky_width: Option<usize>,
+}
+
+/// A pinhole camera.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Eye position; omitted = framed automatically from `direction`.
+    pub eye: Option<[f32; 3]>,
+    /// Look-at point; omitted = the scene's bounding-sphere centre.
+    pub target: Option<[f32; 3]>,
+    /// Direction from the target towards the eye when the eye is framed automatically.
+    #[serde(default = "default_view_direction")]
+    pub direction: [f32; 3],
+    /// Up vector.
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    /// Vertical field of view in degrees.
+    #[serde(default = "default_fov")]
+    pub fov_deg: f32,
+    /// Image width in pixels.
+    #[serde(default = "default_side")]
+    pub width: u32,
+    /// Image height in pixels.
+    #[serde(default = "default_side")]
+    pub height: u32,
+}
+
+fn default_view_direction() -> [f32; 3] {
+    [0.55, 0.45, 1.0]
+}
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+fn default_fov() -> f32 {
+    35.0
+}
+fn default_side() -> u32 {
+    768
+}
+
+impl Default for CameraDesc {
+    fn default() -> Self {
+        Self {
+            eye: None,
+            target: None,
+            direction: default_view_direction(),
+            up: default_up(),
+            fov_deg: default_fov(),
+            width: default_side(),
+            height: default_side(),
+        }
+    }
+}
+
+/// Exposure: a multiplier, or `"auto"` (the 90th percentile of the objects' radiance maps to 0.8).
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, serde::Serialize)]
+#[serde(untagged)]
+pub enum ExposureDesc {
+    /// A fixed multiplier.
+    Fixed(f32),
+    /// `"auto"`.
+    Auto(AutoKeyword),
+}
+
+/// The keyword `auto`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AutoKeyword {
+    /// Automatic exposure.
+    Auto,
+}
+
+/// What is drawn behind the objects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BackgroundDesc {
+    /// The environment map as seen by the camera (black without an environment).
+    #[default]
+    Environment,
+    /// Black.
+    Black,
+}
+
+/// Image outputs, written into the output folder.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputDesc {
+    /// PNG file name (tone-mapped), or omitted for none.
+    #[serde(default = "default_png")]
+    pub png: Option<String>,
+    /// EXR file name (linear radiance), or omitted for none.
+    #[serde(default = "default_exr")]
+    pub exr: Option<String>,
+    /// Exposure multiplier or `"auto"`.
+    #[serde(default = "default_exposure")]
+    pub exposure: ExposureDesc,
+    /// Display gamma.
+    #[serde(default = "default_gamma")]
+    pub gamma: f32,
+    /// Background.
+    #[serde(default)]
+    pub background: BackgroundDesc,
+}
+
+fn default_png() -> Option<String> {
+    Some("render.png".to_owned())
+}
+fn default_exr() -> Option<String> {
+    Some("render.exr".to_owned())
+}
+fn default_exposure() -> ExposureDesc {
+    ExposureDesc::Auto(AutoKeyword::Auto)
+}
+fn default_gamma() -> f32 {
+    2.2
+}
+
+impl Default for OutputDesc {
+    fn default() -> Self {
+        Self {
+            png: default_png(),
+            exr: default_exr(),
+            exposure: default_exposure(),
+            gamma: default_gamma(),
+            background: BackgroundDesc::default(),
+        }
+    }
+}
+
+/// Where an object's geometry comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum GeometrySource {
+    /// The synthetic cloth drape (`synth:cloth`).
+    SynthCloth,
+    /// The obstacle the synthetic cloth falls on (`synth:cloth-obstacle`).
+    SynthClothObstacle,
+    /// A mesh or animation file or folder.
+    File(PathBuf),
+}
+
+/// Where the environment comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum EnvironmentSource {
+    /// The procedural sky (`synth:sky`).
+    SynthSky,
+    /// An equirectangular map file.
+    File(PathBuf),
+}
+
+impl Scene {
+    /// Parse a scene from TOML text; `base_dir` resolves relative paths and `origin` names the
+    /// text in errors.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] with the parser's line and column.
+    pub fn from_toml(text: &str, base_dir: &Path, origin: &str) -> Result<Self, Error> {
+        let mut scene: Scene = toml::from_str(text).map_err(|e| Error::Scene {
+            origin: origin.to_owned(),
+            message: e.to_string(),
+        })?;
+        scene.base_dir = base_dir.to_owned();
+        scene.origin = origin.to_owned();
+        Ok(scene)
+    }
+
+    /// Read and parse a scene file.
+    ///
+    /// # Errors
+    /// [`Error::Io`] when the file cannot be read, [`Error::Scene`] when it does not parse.
+    pub fn load(path: &Path) -> Result<Self, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: path.to_owned(),
+            reason: e.to_string(),
+        })?;
+        let base = path.parent().map(Path::to_owned).unwrap_or_default();
+        Self::from_toml(&text, &base, &path.display().to_string())
+    }
+
+    fn invalid(&self, key: &str, message: String) -> Error {
+        Error::Scene {
+            origin: self.origin.clone(),
+            message: format!("{key}: {message}"),
+        }
+    }
+
+    /// The requested effects, parsed and deduplicated, in stage order.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming an unknown effect and listing the known ones.
+    pub fn requested_effects(&self) -> Result<Vec<Effect>, Error> {
+        let mut effects = Vec::new();
+        for name in &self.effects {
+            let effect = name.parse::<Effect>().map_err(|_| {
+                self.invalid(
+                    "effects",
+                    format!(
+                        "unknown effect {name:?}; known effects: {}",
+                        crate::effects::known_effect_names()
+                    ),
+                )
+            })?;
+            if !effects.contains(&effect) {
+                effects.push(effect);
+            }
+        }
+        effects.sort();
+        Ok(effects)
+    }
+
+    /// Resolve an object's source.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for an unknown `synth:` name.
+    pub fn geometry_source(&self, index: usize) -> Result<GeometrySource, Error> {
+        let object = &self.objects[index];
+        match object.source.strip_prefix(SYNTH_PREFIX) {
+            Some("cloth") => Ok(GeometrySource::SynthCloth),
+            Some("cloth-obstacle") => Ok(GeometrySource::SynthClothObstacle),
+            Some(other) => Err(self.invalid(
+                &format!("object[{index}] ({}).source", object.name),
+                format!("unknown procedural source \"synth:{other}\"; known: synth:cloth, synth:cloth-obstacle"),
+            )),
+            None => Ok(GeometrySource::File(self.base_dir.join(&object.source))),
+        }
+    }
+
+    /// Resolve the environment's source, if there is an environment.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for an unknown `synth:` name.
+    pub fn environment_source(&self) -> Result<Option<EnvironmentSource>, Error> {
+        let Some(env) = &self.environment else {
+            return Ok(None);
+        };
+        match env.source.strip_prefix(SYNTH_PREFIX) {
+            Some("sky") => Ok(Some(EnvironmentSource::SynthSky)),
+            Some(other) => Err(self.invalid(
+                "environment.source",
+                format!("unknown procedural source \"synth:{other}\"; known: synth:sky"),
+            )),
+            None => Ok(Some(EnvironmentSource::File(
+                self.base_dir.join(&env.source),
+            ))),
+        }
+    }
+
+    /// Check everything that can be checked without doing the work: effect names and
+    /// availability, value ranges, and that every named file exists.
+    ///
+    /// # Errors
+    /// The first problem found, naming the scene, the key and the value.
+    pub fn validate(&self) -> Result<Vec<Effect>, Error> {
+        let effects = self.requested_effects()?;
+        if let Some(missing) = effects.iter().find(|e| !e.is_built()) {
+            return Err(Error::EffectNotBuilt {
+                origin: self.origin.clone(),
+                effect: missing.name(),
+                provider: missing.provider(),
+            });
+        }
+        if self.objects.is_empty() {
+            return Err(self.invalid(
+                "object",
+                "the scene has no [[object]]; add at least one".to_owned(),
+            ));
+        }
+        for (i, object) in self.objects.iter().enumerate() {
+            let key = |field: &str| format!("object[{i}] ({}).{field}", object.name);
+            if self.objects[..i].iter().any(|o| o.name == object.name) {
+                return Err(self.invalid(
+                    &key("name"),
+                    format!("duplicate object name {:?}", object.name),
+                ));
+            }
+            if let Some(c) = object.albedo.iter().find(|c| !(0.0..=1.0).contains(*c)) {
+                return Err(self.invalid(&key("albedo"), format!("{c} is outside [0, 1]")));
+            }
+            if !(object.scale.is_finite() && object.scale > 0.0) {
+                return Err(self.invalid(
+                    &key("scale"),
+                    format!("{} must be finite and > 0", object.scale),
+                ));
+            }
+            let finite = object
+                .translation
+                .iter()
+                .chain(&object.rotation_deg)
+                .all(|v| v.is_finite());
+            if !finite {
+                return Err(self.invalid(
+                    &key("translation/rotation_deg"),
+                    "values must be finite".to_owned(),
+                ));
+            }
+            if let GeometrySource::File(path) = self.geometry_source(i)? {
+                if !path.exists() {
+                    return Err(
+                        self.invalid(&key("source"), format!("{} does not exist", path.display()))
+                    );
+                }
+            }
+        }
+        if effects.contains(&Effect::Lighting) && self.environment.is_none() {
+            return Err(self.invalid(
+                "environment",
+                "effect \"lighting\" needs an [environment] (e.g. source = \"synth:sky\")"
+                    .to_owned(),
+            ));
+        }
+        if let Some(EnvironmentSource::File(path)) = self.environment_source()? {
+            if !path.exists() {
+                return Err(self.invalid(
+                    "environment.source",
+                    format!("{} does not exist", path.display()),
+                ));
+            }
+        }
+        if let Some(env) = &self.environment {
+            let s = env.prefilter_sigma_deg;
+            if !(s.is_finite() && (0.0..=90.0).contains(&s)) {
+                return Err(self.invalid(
+                    "environment.prefilter_sigma_deg",
+                    format!("{s} is outside [0, 90]"),
+                ));
+            }
+            if !env.rotation_deg.is_finite() {
+                return Err(self.invalid(
+                    "environment.rotation_deg",
+                    format!("{} is not finite", env.rotation_deg),
+                ));
+            }
+        }
+        if self.lighting.level > MAX_LEVEL {
+            return Err(self.invalid(
+                "lighting.level",
+                format!("{} exceeds the maximum {MAX_LEVEL}", self.lighting.level),
+            ));
+        }
+        let cam = &self.camera;
+        for (key, side) in [("camera.width", cam.width), ("camera.height", cam.height)] {
+            if side == 0 || side > MAX_IMAGE_SIDE {
+                return Err(self.invalid(key, format!("{side} is outside 1..={MAX_IMAGE_SIDE}")));
+            }
+        }
+        if !(cam.fov_deg > 0.0 && cam.fov_deg < 179.0) {
+            return Err(self.invalid(
+                "camera.fov_deg",
+                format!("{} is outside (0, 179)", cam.fov_deg),
+            ));
+        }
+        if let ExposureDesc::Fixed(x) = self.output.exposure {
+            if !(x.is_finite() && x > 0.0) {
+                return Err(self.invalid(
+                    "output.exposure",
+                    format!("{x} must be finite and > 0, or \"auto\""),
+                ));
+            }
+        }
+        if !(self.output.gamma.is_finite() && self.output.gamma > 0.0) {
+            return Err(self.invalid(
+                "output.gamma",
+                format!("{} must be finite and > 0", self.output.gamma),
+            ));
+        }
+        for (key, name) in [
+            ("output.png", &self.output.png),
+            ("output.exr", &self.output.exr),
+        ] {
+            if let Some(name) = name {
+                let plain = Path::new(name)
+                    .file_name()
+                    .is_some_and(|f| f == name.as_str());
+                if !plain {
+                    return Err(self.invalid(
+                        key,
+                        format!("{name:?} must be a plain file name inside the output folder"),
+                    ));
+                }
+            }
+        }
+        if let Some(grid) = self.synth.cloth_grid {
+            if !(2..=1024).contains(&grid) {
+                return Err(self.invalid("synth.cloth_grid", format!("{grid} is outside 2..=1024")));
+            }
+        }
+        if let Some(frames) = self.synth.cloth_frames {
+            if !(1..=100_000).contains(&frames) {
+                return Err(self.invalid(
+                    "synth.cloth_frames",
+                    format!("{frames} is outside 1..=100000"),
+                ));
+            }
+        }
+        Ok(effects)
+    }
+}

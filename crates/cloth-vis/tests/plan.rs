@@ -1,0 +1,151 @@
+//! The effect graph: a scene never builds the stages of effects it does not ask for, and every
+//! problem that needs no work is reported before any work starts.
+
+mod common;
+
+use cloth_vis::{Error, Plan, RunOptions, Stage, demo_scene, run_scene};
+use common::scene;
+
+const CLOTH: &str = r#"
+[[object]]
+name = "cloth"
+source = "synth:cloth"
+"#;
+
+#[test]
+fn a_scene_without_lighting_never_builds_lighting_stages() {
+    let s = scene(CLOTH, ".".as_ref());
+    let plan = Plan::for_scene(&s).unwrap();
+    assert_eq!(plan.stages(), &[Stage::Geometry, Stage::Render]);
+    assert!(plan.effects().is_empty());
+    // An environment used only as backdrop loads the map but still builds no lighting stage.
+    let with_env = format!("{CLOTH}\n[environment]\nsource = \"synth:sky\"\n");
+    let plan = Plan::for_scene(&scene(&with_env, ".".as_ref())).unwrap();
+    assert_eq!(
+        plan.stages(),
+        &[Stage::Geometry, Stage::Environment, Stage::Render]
+    );
+    let black = format!("{with_env}\n[output]\nbackground = \"black\"\n");
+    let plan = Plan::for_scene(&scene(&black, ".".as_ref())).unwrap();
+    assert_eq!(plan.stages(), &[Stage::Geometry, Stage::Render]);
+}
+
+#[test]
+fn the_demo_scene_plans_lighting() {
+    let plan = Plan::for_scene(&demo_scene().unwrap()).unwrap();
+    assert_eq!(
+        plan.stages(),
+        &[
+            Stage::Geometry,
+            Stage::Environment,
+            Stage::LightDirections,
+            Stage::Lighting,
+            Stage::Render
+        ]
+    );
+}
+
+#[test]
+fn an_effect_not_built_yet_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let text = format!(
+        "effects = [\"lighting\", \"self-shadowing\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
+    );
+    let err = run_scene(&scene(&text, dir.path()), &out, &RunOptions::default()).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            Error::EffectNotBuilt {
+                effect: "self-shadowing",
+                provider: "occlusion-gpu",
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("self-shadowing"), "{err}");
+    assert!(
+        !out.exists(),
+        "no output folder may be created before validation passes"
+    );
+}
+
+#[test]
+fn unknown_effects_list_the_known_ones() {
+    let text = format!("effects = [\"ambient-occlusion\"]\n{CLOTH}");
+    let err = Plan::for_scene(&scene(&text, ".".as_ref()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("\"ambient-occlusion\"")
+            && err.contains("self-shadowing")
+            && err.contains("lighting"),
+        "{err}"
+    );
+}
+
+#[test]
+fn missing_files_are_named_with_their_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = "[[object]]\nname = \"bunny\"\nsource = \"no/such/bunny.ply\"\n";
+    let err = Plan::for_scene(&scene(text, dir.path()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("object[0] (bunny).source") && err.contains("no/such/bunny.ply"),
+        "{err}"
+    );
+    let text = format!("{CLOTH}\n[environment]\nsource = \"sky.hdr\"\n");
+    let err = Plan::for_scene(&scene(&text, dir.path()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("environment.source") && err.contains("sky.hdr"),
+        "{err}"
+    );
+}
+
+#[test]
+fn lighting_without_an_environment_is_refused() {
+    let text = format!("effects = [\"lighting\"]\n{CLOTH}");
+    let err = Plan::for_scene(&scene(&text, ".".as_ref()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("[environment]"), "{err}");
+}
+
+#[test]
+fn typos_and_bad_values_are_reported_with_location() {
+    let err = cloth_vis::Scene::from_toml(
+        "[[object]]\nname = \"a\"\nsourse = \"x\"\n",
+        ".".as_ref(),
+        "typo.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("typo.toml") && err.contains("sourse"), "{err}");
+    for (extra, key) in [
+        ("[lighting]\nlevel = 9\n", "lighting.level"),
+        ("[camera]\nwidth = 0\n", "camera.width"),
+        ("[camera]\nfov_deg = 180.0\n", "camera.fov_deg"),
+        ("[output]\nexposure = -1.0\n", "output.exposure"),
+        ("[output]\npng = \"../escape.png\"\n", "output.png"),
+        ("[synth]\ncloth_grid = 1\n", "synth.cloth_grid"),
+    ] {
+        let err = Plan::for_scene(&scene(&format!("{CLOTH}\n{extra}"), ".".as_ref()))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(key), "{key}: {err}");
+    }
+    let dup = format!("{CLOTH}{CLOTH}");
+    let err = Plan::for_scene(&scene(&dup, ".".as_ref()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("duplicate object name"), "{err}");
+    let albedo = "[[object]]\nname = \"a\"\nsource = \"synth:cloth\"\nalbedo = [0.5, 1.5, 0.5]\n";
+    let err = Plan::for_scene(&scene(albedo, ".".as_ref()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("albedo") && err.contains("1.5"), "{err}");
+}
