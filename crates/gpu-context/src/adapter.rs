@@ -86,15 +86,18 @@ impl GpuContext {
     /// [`GpuError::AdapterNotFound`] when a named adapter is missing,
     /// [`GpuError::RequestDevice`] when the adapter refuses the device.
     pub fn new(options: &GpuOptions) -> Result<Self, GpuError> {
-        let backends = options
+        let requested = options
             .backends
             .or_else(|| env_nonempty(BACKEND_ENV).map(|s| wgpu::Backends::from_comma_list(&s)))
-            .or_else(wgpu::Backends::from_env)
-            .unwrap_or(wgpu::Backends::all());
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
-        let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+            .or_else(wgpu::Backends::from_env);
+        // Without a request, probe the primary backends (Vulkan, Metal, DX12) first and GL only
+        // when they offer nothing: probing GL on a headless machine logs EGL errors.
+        let mut backends = requested.unwrap_or(wgpu::Backends::PRIMARY);
+        let (mut instance, mut adapters) = enumerate(backends);
+        if requested.is_none() && adapters.is_empty() {
+            backends = wgpu::Backends::all();
+            (instance, adapters) = enumerate(backends);
+        }
 
         let wanted = options
             .adapter_name
@@ -173,6 +176,14 @@ impl GpuContext {
             .map(|_| ())
             .map_err(|e| GpuError::Readback(e.to_string()))
     }
+}
+
+fn enumerate(backends: wgpu::Backends) -> (wgpu::Instance, Vec<wgpu::Adapter>) {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = backends;
+    let instance = wgpu::Instance::new(desc);
+    let adapters = pollster::block_on(instance.enumerate_adapters(backends));
+    (instance, adapters)
 }
 
 fn env_nonempty(name: &str) -> Option<String> {
