@@ -1,5 +1,6 @@
 //! The `cloth-vis` command line.
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -52,6 +53,13 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        // A closed pipe (`cloth-vis inspect … | head`) is not an error of ours.
+        Err(e)
+            if e.downcast_ref::<std::io::Error>()
+                .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
@@ -68,7 +76,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 ..RunOptions::default()
             };
             let output = cloth_vis::run_scene(&scene, &out, &options)?;
-            print!("{}", output.report.table());
+            write!(std::io::stdout().lock(), "{}", output.report.table())?;
         }
         Command::Demo { out, quiet } => {
             let options = RunOptions {
@@ -76,7 +84,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 ..RunOptions::default()
             };
             let output = cloth_vis::run_demo(&out, &options)?;
-            print!("{}", output.report.table());
+            write!(std::io::stdout().lock(), "{}", output.report.table())?;
         }
         Command::Inspect { input, animation } => inspect(&input, animation)?,
     }
@@ -89,35 +97,39 @@ fn inspect(input: &Path, animation: bool) -> anyhow::Result<()> {
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case(ext))
     };
+    let mut out = std::io::stdout().lock();
     let start = Instant::now();
     if animation || input.is_dir() || has_ext("npy") {
         let (anim, report) = meshio::load_animation(input, &meshio::AnimationOptions::default())?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
-        println!(
+        writeln!(
+            out,
             "{}: animation, {} frames x {} vertices, {} triangles, {:.1} fps, loaded in {ms:.1} ms",
             input.display(),
             anim.frame_count(),
             anim.vertex_count(),
             anim.triangles.len(),
             anim.frame_rate
-        );
-        println!("{report:#?}");
+        )?;
+        writeln!(out, "{report:#?}")?;
     } else {
         let (mesh, report) = meshio::load_mesh(input, &meshio::LoadOptions::default())?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
-        println!(
+        writeln!(
+            out,
             "{}: {} vertices, {} triangles, loaded in {ms:.1} ms",
             input.display(),
             mesh.vertex_count(),
             mesh.triangle_count()
-        );
-        println!(
+        )?;
+        writeln!(
+            out,
             "unreferenced vertices: {}, degenerate triangles: {}, duplicate positions: {}, normals computed: {}",
             report.unreferenced_vertices.len(),
             report.degenerate_triangles.len(),
             report.duplicate_positions,
             report.normals_computed
-        );
+        )?;
     }
     Ok(())
 }
