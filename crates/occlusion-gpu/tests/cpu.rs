@@ -1,0 +1,229 @@
+//! The `cpu` backend against brute-force f64 ray casting and its defining identities.
+
+mod common;
+
+use common::*;
+use glam::{DVec3, Mat4, Quat, Vec3};
+use lightsphere::Lightsphere;
+use occlusion_gpu::{OcclusionError, Scene, SceneObject, VisibilityEngine, VisibilityParams};
+
+fn engine() -> VisibilityEngine {
+    VisibilityEngine::cpu(VisibilityParams::default())
+}
+
+/// Every entry of M equals an f64 brute-force ray cast over all triangles (no BVH), except
+/// where the ray passes within float noise of a triangle edge.
+#[test]
+fn matches_brute_force_on_sphere_over_plane() {
+    let scene = sphere_over_plane();
+    let sphere = Lightsphere::new(2).unwrap();
+    let matrix = engine().compute(&scene, &sphere).unwrap();
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let mut normals = Vec::new();
+    for object in scene.objects() {
+        let base = positions.len() as u32;
+        positions.extend(object.positions.iter().map(|p| p.as_dvec3()));
+        normals.extend(object.normals.iter().map(|n| n.as_dvec3()));
+        triangles.extend(object.triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+    let (lo, hi) = positions.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let offset = 1e-4 * (hi - lo).length();
+    let mut disagreements = 0;
+    for (i, (p, n)) in positions.iter().zip(&normals).enumerate() {
+        for (j, l) in sphere.directions_f64().iter().enumerate() {
+            let expected =
+                n.dot(*l) > 0.0 && !brute_force_hit(&positions, &triangles, *p + *n * offset, *l);
+            // n·l within f32 rounding of 0 may be culled either way (M_ij ≈ 0 regardless).
+            let grazing = n.dot(*l).abs() < 1e-6;
+            if matrix.is_visible(i, j) != expected && !grazing {
+                if disagreements < 10 {
+                    eprintln!("differs: vertex {i} direction {j}: p {p} n {n} l {l}");
+                }
+                disagreements += 1;
+            }
+        }
+    }
+    let total = positions.len() * sphere.len();
+    // Only rays grazing an edge within f32 rounding may differ: at most 1e-4 of the entries.
+    assert!(
+        disagreements * 10_000 <= total,
+        "{disagreements} of {total} entries differ from brute force"
+    );
+    assert!(
+        matrix.visible_count() > total / 4,
+        "too few visible entries"
+    );
+}
+
+/// A point on the plane under the sphere's centre: the sphere hides a cap of half-angle
+/// asin(r/d), cosine-weighted occlusion (r/d)².
+#[test]
+fn sphere_cap_occlusion_is_analytic() {
+    let scene = sphere_over_plane();
+    let sphere = Lightsphere::new(5).unwrap();
+    let matrix = engine().compute(&scene, &sphere).unwrap();
+    let ambient = matrix.ambient();
+    // Grid 24×24: vertex (12, 12) is the centre.
+    let centre = 12 * 25 + 12;
+    let (r, d) = (0.5f64, 0.7f64);
+    // The tessellated sphere (16 rings) is inscribed in the true one: allow 0.02 plus the
+    // level-5 quadrature error (≈ 0.01).
+    assert_close(
+        f64::from(ambient[centre]),
+        1.0 - (r / d).powi(2),
+        0.03,
+        "a under sphere",
+    );
+}
+
+/// Refining level 1 to level 3 gives exactly the matrix computed at level 3 directly.
+#[test]
+fn refine_equals_direct_computation() {
+    let scene = sphere_over_plane();
+    let coarse = Lightsphere::new(1).unwrap();
+    let fine = Lightsphere::new(3).unwrap();
+    let mut engine = engine();
+    let mut refined = engine.compute(&scene, &coarse).unwrap();
+    engine.refine(&scene, &mut refined, &fine).unwrap();
+    let new_rays = engine.last_ray_count();
+    let direct = engine.compute(&scene, &fine).unwrap();
+    assert_eq!(refined, direct);
+    assert!(
+        new_rays < engine.last_ray_count(),
+        "refine recast old directions"
+    );
+    // Refining to a coarser level is refused.
+    let mut matrix = direct.clone();
+    let error = engine.refine(&scene, &mut matrix, &coarse).unwrap_err();
+    assert!(
+        matches!(error, OcclusionError::NotARefinement { .. }),
+        "{error}"
+    );
+}
+
+/// c_i under I_j = ω_j/π (grey) equals a_i: the two outputs share one definition of M.
+#[test]
+fn radiance_with_solid_angle_light_equals_ambient() {
+    let scene = sphere_over_plane();
+    let sphere = Lightsphere::new(2).unwrap();
+    let matrix = engine().compute(&scene, &sphere).unwrap();
+    let light: Vec<Vec3> = sphere
+        .solid_angles()
+        .iter()
+        .map(|w| Vec3::splat((w / std::f64::consts::PI) as f32))
+        .collect();
+    let radiance = matrix.radiance(&light).unwrap();
+    for (c, a) in radiance.iter().zip(matrix.ambient()) {
+        assert!(
+            (c.x - a).abs() <= 1e-5 * a.abs().max(1.0),
+            "c = {c}, a = {a}"
+        );
+    }
+    let dense = matrix.to_dense();
+    assert_eq!(dense.len(), matrix.rows() * sphere.len());
+    assert!(matrix.radiance(&light[1..]).is_err());
+}
+
+/// A transformed object gives the same matrix as the same mesh transformed beforehand, and
+/// a rigid rotation of the whole scene equals rotating the directions (the look-up).
+#[test]
+fn transforms_match_pretransformed_geometry() {
+    let sphere = Lightsphere::new(2).unwrap();
+    let plane = grid(8, 2.0);
+    let ball = uv_sphere(Vec3::ZERO, 0.4, 8, 16);
+    let world_from_ball = Mat4::from_scale_rotation_translation(
+        Vec3::splat(1.5),
+        Quat::from_rotation_z(0.4),
+        Vec3::new(0.1, 0.8, 0.0),
+    );
+    let mut placed = Scene::new();
+    placed.push(plane.object()).unwrap();
+    placed
+        .push(ball.object().with_transform(world_from_ball))
+        .unwrap();
+    let mut baked = Scene::new();
+    baked.push(plane.object()).unwrap();
+    baked
+        .push(SceneObject::new(
+            ball.positions
+                .iter()
+                .map(|p| world_from_ball.transform_point3(*p))
+                .collect(),
+            ball.normals
+                .iter()
+                .map(|n| (Quat::from_rotation_z(0.4) * *n).normalize())
+                .collect(),
+            ball.triangles.clone(),
+        ))
+        .unwrap();
+    let a = engine().compute(&placed, &sphere).unwrap().ambient();
+    let b = engine().compute(&baked, &sphere).unwrap().ambient();
+    // f32 rounding of the two placements flips at most a few grazing rays (each worth
+    // ω_j n·l_j / π < 0.05 at level 2).
+    let (mean, share) = ambient_difference(&a, &b);
+    assert!(mean < 1e-3 && share == 0.0, "mean {mean}, share {share}");
+    assert_eq!(placed.receiver_rows(1), Some(81..81 + ball.positions.len()));
+}
+
+/// An occluder-only object casts shadows but has no rows.
+#[test]
+fn occluder_only_objects_shadow_without_rows() {
+    let sphere = Lightsphere::new(2).unwrap();
+    let mut scene = Scene::new();
+    scene.push(grid(4, 2.0).object()).unwrap();
+    let ball = uv_sphere(Vec3::new(0.0, 0.6, 0.0), 0.4, 8, 16);
+    scene.push(ball.object().occluder_only()).unwrap();
+    assert_eq!(scene.receiver_count(), 25);
+    assert_eq!(scene.receiver_rows(1), None);
+    let ambient = engine().compute(&scene, &sphere).unwrap().ambient();
+    assert_eq!(ambient.len(), 25);
+    let open = open_ambient(&sphere, DVec3::Y);
+    assert!(
+        f64::from(ambient[12]) < open - 0.2,
+        "centre not shadowed: {}",
+        ambient[12]
+    );
+}
+
+/// Invalid scenes are rejected with errors naming the element.
+#[test]
+fn invalid_scenes_are_rejected() {
+    let mut scene = Scene::new();
+    let bad_index = SceneObject::new(vec![Vec3::ZERO; 3], vec![Vec3::Y; 3], vec![[0, 1, 3]]);
+    let error = scene.push(bad_index).unwrap_err();
+    assert!(error.to_string().contains("vertex index 3"), "{error}");
+    let bad_normals = SceneObject::new(vec![Vec3::ZERO; 3], vec![Vec3::Y; 2], vec![[0, 1, 2]]);
+    assert!(matches!(
+        scene.push(bad_normals),
+        Err(OcclusionError::NormalCountMismatch { .. })
+    ));
+    let nan = SceneObject::new(vec![Vec3::NAN; 3], vec![Vec3::Y; 3], vec![[0, 1, 2]]);
+    assert!(matches!(
+        scene.push(nan),
+        Err(OcclusionError::NonFinite { .. })
+    ));
+    let sphere = Lightsphere::new(0).unwrap();
+    assert!(matches!(
+        engine().compute(&Scene::new(), &sphere),
+        Err(OcclusionError::EmptyScene { .. })
+    ));
+}
+
+/// The full bunny at level 2: finite, in [0, 1.05], and the mean is plausible.
+#[test]
+fn bunny_res4_is_finite_and_bounded() {
+    let Some(scene) = shared_scene("meshes/bun_zipper_res4.ply") else {
+        return;
+    };
+    let sphere = Lightsphere::new(2).unwrap();
+    let ambient = engine().compute(&scene, &sphere).unwrap().ambient();
+    let finite: Vec<f32> = ambient.iter().copied().filter(|a| a.is_finite()).collect();
+    assert!(!finite.is_empty());
+    assert!(finite.iter().all(|a| (0.0..=1.05).contains(a)));
+    let mean = finite.iter().sum::<f32>() / finite.len() as f32;
+    assert!((0.4..0.95).contains(&mean), "mean ambient {mean}");
+}
