@@ -40,6 +40,9 @@ pub enum Error {
     /// An environment or lightsphere problem.
     #[error(transparent)]
     Light(#[from] lightsphere::LightsphereError),
+    /// The visibility engine failed.
+    #[error(transparent)]
+    Visibility(#[from] occlusion_gpu::OcclusionError),
     /// Procedural data could not be made.
     #[error(transparent)]
     Synth(#[from] synth::SynthError),

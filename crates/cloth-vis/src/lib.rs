@@ -43,6 +43,7 @@ pub mod render;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod shadowing;
 
 pub use demo::{DEMO_SCENE, demo_scene, run_demo};
 pub use effects::Effect;

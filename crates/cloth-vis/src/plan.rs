@@ -4,8 +4,9 @@
 //! |---|---|
 //! | `geometry` | always (meshes, animation frames, procedural cloth) |
 //! | `environment` | `lighting` is requested, or an environment is drawn as the backdrop |
-//! | `light-directions` | `lighting` (lightsphere level, I_j per direction) |
-//! | `lighting` | `lighting` (per-vertex radiance) |
+//! | `light-directions` | `lighting` or `self-shadowing` (lightsphere level, I_j per direction) |
+//! | `visibility` | `self-shadowing` (the visibility matrix M, occlusion-gpu) |
+//! | `lighting` | `lighting` or `self-shadowing` (per-vertex radiance, with M when computed) |
 //! | `render` | always (PNG/EXR) |
 //!
 //! Later effects (self-shadowing, BTF, shadow volumes, translucency) add their own stages here
@@ -26,6 +27,8 @@ pub enum Stage {
     Environment,
     /// Build the lightsphere and sample I_j per direction.
     LightDirections,
+    /// The visibility matrix M of every vertex towards every light direction.
+    Visibility,
     /// Per-vertex image-based radiance.
     Lighting,
     /// Rasterise and write images.
@@ -39,6 +42,7 @@ impl Stage {
             Stage::Geometry => "geometry",
             Stage::Environment => "environment",
             Stage::LightDirections => "light-directions",
+            Stage::Visibility => "visibility",
             Stage::Lighting => "lighting",
             Stage::Render => "render",
         }
@@ -48,10 +52,14 @@ impl Stage {
     pub fn needed_by(effect: Effect) -> &'static [Stage] {
         match effect {
             Effect::Lighting => &[Stage::Environment, Stage::LightDirections, Stage::Lighting],
+            Effect::SelfShadowing => &[
+                Stage::Environment,
+                Stage::LightDirections,
+                Stage::Visibility,
+                Stage::Lighting,
+            ],
             // Not built yet: validation rejects them before planning.
-            Effect::SelfShadowing | Effect::Btf | Effect::ShadowVolumes | Effect::Translucency => {
-                &[]
-            }
+            Effect::Btf | Effect::ShadowVolumes | Effect::Translucency => &[],
         }
     }
 }

@@ -115,36 +115,26 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         })?;
         let (sphere, radiance) =
             timer.run(Stage::LightDirections, || light_directions(scene, env))?;
+        let visibility = if plan.contains(Stage::Visibility) {
+            Some(timer.run(Stage::Visibility, || {
+                crate::shadowing::visibility(scene, &gpu, &objects, &sphere)
+            })?)
+        } else {
+            None
+        };
         timer.run(Stage::Lighting, || {
-            let mut vertices = 0;
-            for object in &mut objects {
-                let front = crate::lighting::lambertian_radiance(
-                    &object.normals,
-                    sphere.directions(),
-                    sphere.solid_angles(),
-                    &radiance,
-                    object.albedo,
-                );
-                let back = if object.two_sided {
-                    let flipped: Vec<Vec3> = object.normals.iter().map(|n| -*n).collect();
-                    crate::lighting::lambertian_radiance(
-                        &flipped,
-                        sphere.directions(),
-                        sphere.solid_angles(),
-                        &radiance,
-                        object.albedo,
-                    )
-                } else {
-                    front.clone()
-                };
-                vertices += object.positions.len();
-                object.front = Some(front);
-                object.back = Some(back);
-            }
-            Ok((
-                (),
-                json!({ "vertices": vertices, "directions": sphere.len() }),
-            ))
+            let vertices = crate::shadowing::light_objects(
+                &mut objects,
+                &sphere,
+                &radiance,
+                visibility.as_ref(),
+            )?;
+            let params = json!({
+                "vertices": vertices,
+                "directions": sphere.len(),
+                "visibility": visibility.is_some(),
+            });
+            Ok(((), params))
         })?;
     }
 

@@ -59,6 +59,9 @@ pub struct Scene {
     /// Lighting parameters.
     #[serde(default)]
     pub lighting: LightingDesc,
+    /// Visibility parameters (the `self-shadowing` effect).
+    #[serde(default)]
+    pub visibility: VisibilityDesc,
     /// Procedural data parameters (for `synth:` sources).
     #[serde(default)]
     pub synth: SynthDesc,
@@ -173,6 +176,45 @@ impl Default for LightingDesc {
         Self {
             level: default_level(),
             method: RadianceMethodDesc::default(),
+        }
+    }
+}
+
+/// Which visibility backend computes M.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum VisibilityBackendDesc {
+    /// `depth` on a hardware adapter, `cpu` on a software one (lavapipe rasterises on the CPU,
+    /// where exact ray casting is both faster and exact).
+    #[default]
+    Auto,
+    /// Exact ray casting on the CPU (the reference).
+    Cpu,
+    /// GPU depth maps and a compute-pass depth test.
+    Depth,
+}
+
+/// Visibility parameters.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VisibilityDesc {
+    /// Backend.
+    #[serde(default)]
+    pub backend: VisibilityBackendDesc,
+    /// Depth-map side for the `depth` backend.
+    #[serde(default = "default_depth_resolution")]
+    pub depth_resolution: u32,
+}
+
+fn default_depth_resolution() -> u32 {
+    occlusion_gpu::DEFAULT_DEPTH_RESOLUTION
+}
+
+impl Default for VisibilityDesc {
+    fn default() -> Self {
+        Self {
+            backend: VisibilityBackendDesc::default(),
+            depth_resolution: default_depth_resolution(),
         }
     }
 }
@@ -496,11 +538,20 @@ impl Scene {
                 }
             }
         }
-        if effects.contains(&Effect::Lighting) && self.environment.is_none() {
+        let lit = effects
+            .iter()
+            .find(|e| matches!(e, Effect::Lighting | Effect::SelfShadowing));
+        if let (Some(effect), None) = (lit, &self.environment) {
             return Err(self.invalid(
                 "environment",
-                "effect \"lighting\" needs an [environment] (e.g. source = \"synth:sky\")"
-                    .to_owned(),
+                format!("effect \"{effect}\" needs an [environment] (e.g. source = \"synth:sky\")"),
+            ));
+        }
+        let res = self.visibility.depth_resolution;
+        if !(16..=16384).contains(&res) {
+            return Err(self.invalid(
+                "visibility.depth_resolution",
+                format!("{res} is outside 16..=16384"),
             ));
         }
         if let Some(EnvironmentSource::File(path)) = self.environment_source()? {

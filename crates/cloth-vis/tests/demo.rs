@@ -58,7 +58,19 @@ fn demo_writes_non_constant_png_exr_and_a_report_of_the_planned_stages() {
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("run-report.json")).unwrap())
             .unwrap();
-    assert_eq!(json["effects"], serde_json::json!(["lighting"]));
+    assert_eq!(
+        json["effects"],
+        serde_json::json!(["lighting", "self-shadowing"])
+    );
+    let vis = json["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["stage"] == "visibility")
+        .unwrap();
+    // A draped cloth shadows itself: some but not all (vertex, direction) pairs are visible.
+    let share = vis["params"]["visible_share"].as_f64().unwrap();
+    assert!(share > 0.05 && share < 0.5, "{vis}");
     assert_eq!(json["stages"].as_array().unwrap().len(), planned.len());
     // Cell-mean I_j preserves the sky's power (lightsphere's guarantee, seen through the facade).
     let light = json["stages"]

@@ -39,6 +39,7 @@ fn the_demo_scene_plans_lighting() {
             Stage::Geometry,
             Stage::Environment,
             Stage::LightDirections,
+            Stage::Visibility,
             Stage::Lighting,
             Stage::Render
         ]
@@ -50,25 +51,42 @@ fn an_effect_not_built_yet_is_refused_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let text = format!(
-        "effects = [\"lighting\", \"self-shadowing\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
+        "effects = [\"lighting\", \"btf\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
     );
     let err = run_scene(&scene(&text, dir.path()), &out, &RunOptions::default()).unwrap_err();
     assert!(
         matches!(
             err,
             Error::EffectNotBuilt {
-                effect: "self-shadowing",
-                provider: "occlusion-gpu",
+                effect: "btf",
+                provider: "btf",
                 ..
             }
         ),
         "{err}"
     );
-    assert!(err.to_string().contains("self-shadowing"), "{err}");
+    assert!(err.to_string().contains("\"btf\""), "{err}");
     assert!(
         !out.exists(),
         "no output folder may be created before validation passes"
     );
+}
+
+#[test]
+fn self_shadowing_plans_visibility_but_lighting_alone_does_not() {
+    let sky = "[environment]\nsource = \"synth:sky\"\n";
+    let lit = Plan::for_scene(&scene(
+        &format!("effects = [\"lighting\"]\n{CLOTH}{sky}"),
+        ".".as_ref(),
+    ))
+    .unwrap();
+    assert!(lit.contains(Stage::Lighting) && !lit.contains(Stage::Visibility));
+    let shadowed = Plan::for_scene(&scene(
+        &format!("effects = [\"self-shadowing\"]\n{CLOTH}{sky}"),
+        ".".as_ref(),
+    ))
+    .unwrap();
+    assert!(shadowed.contains(Stage::Visibility) && shadowed.contains(Stage::Lighting));
 }
 
 #[test]

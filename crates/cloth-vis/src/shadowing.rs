@@ -1,0 +1,151 @@
+//! The `self-shadowing` effect: the visibility matrix M of every vertex towards every light
+//! direction (occlusion-gpu, paper 000 §3), and per-vertex radiance with it:
+//! c_i = (ρ/π) Σ_j M_ij I_j ω_j, where M_ij = n_i·l_j if vertex i sees direction j, else 0.
+//!
+//! Two-sided objects (cloth) get a second set of rows computed with flipped normals, so the
+//! underside is lit by what it sees, not by what the top side sees.
+
+use glam::Vec3;
+use gpu_context::GpuContext;
+use occlusion_gpu::{
+    Backend, DepthParams, SceneObject, VisibilityEngine, VisibilityMatrix, VisibilityParams,
+};
+use serde_json::json;
+
+use crate::Error;
+use crate::run::WorldObject;
+use crate::scene::{Scene, VisibilityBackendDesc};
+
+/// M for every object (and for the flipped side of two-sided ones), with the row ranges.
+#[derive(Debug)]
+pub struct Visibility {
+    matrix: VisibilityMatrix,
+    /// Per object: rows of the front side, and of the back side when two-sided.
+    rows: Vec<(std::ops::Range<usize>, Option<std::ops::Range<usize>>)>,
+}
+
+/// Compute M for all objects, each object occluding all others.
+///
+/// # Errors
+/// [`Error::Visibility`] when the engine rejects the scene or the GPU fails.
+pub fn visibility(
+    scene: &Scene,
+    gpu: &GpuContext,
+    objects: &[WorldObject],
+    sphere: &lightsphere::Lightsphere,
+) -> Result<(Visibility, serde_json::Value), Error> {
+    let mut occ = occlusion_gpu::Scene::new();
+    let mut indices = Vec::with_capacity(objects.len());
+    for object in objects {
+        let front = occ.push(SceneObject::new(
+            object.positions.clone(),
+            object.normals.clone(),
+            object.triangles.clone(),
+        ))?;
+        let back = if object.two_sided {
+            let flipped: Vec<Vec3> = object.normals.iter().map(|n| -*n).collect();
+            let copy =
+                SceneObject::new(object.positions.clone(), flipped, object.triangles.clone());
+            Some(occ.push(copy)?)
+        } else {
+            None
+        };
+        indices.push((front, back));
+    }
+    let backend = match scene.visibility.backend {
+        VisibilityBackendDesc::Cpu => Backend::Cpu,
+        VisibilityBackendDesc::Depth => Backend::Depth,
+        VisibilityBackendDesc::Auto if gpu.summary().is_software => Backend::Cpu,
+        VisibilityBackendDesc::Auto => Backend::Depth,
+    };
+    let params = VisibilityParams::default()
+        .with_depth(DepthParams::default().with_resolution(scene.visibility.depth_resolution));
+    let mut engine = match backend {
+        Backend::Cpu => VisibilityEngine::cpu(params),
+        other => VisibilityEngine::with_gpu(&gpu.device, &gpu.queue, other, params),
+    };
+    let matrix = engine.compute(&occ, sphere)?;
+    let rows = indices
+        .iter()
+        .map(|(front, back)| {
+            let f = occ.receiver_rows(*front).unwrap_or(0..0);
+            (f, back.and_then(|b| occ.receiver_rows(b)))
+        })
+        .collect();
+    let total = matrix.rows() * matrix.directions_len();
+    let report = json!({
+        "backend": backend.name(),
+        "rows": matrix.rows(),
+        "directions": matrix.directions_len(),
+        "visible_share": matrix.visible_count() as f64 / total.max(1) as f64,
+        "rays": engine.last_ray_count(),
+        "depth_resolution": scene.visibility.depth_resolution,
+    });
+    Ok((Visibility { matrix, rows }, report))
+}
+
+/// Light every object: with M when `visibility` is given, else with M_ij = max(0, n_i·l_j).
+/// Returns the number of vertices lit.
+///
+/// # Errors
+/// [`Error::Visibility`] or [`Error::Light`] if the radiance and the directions disagree
+/// (an internal bug).
+pub fn light_objects(
+    objects: &mut [WorldObject],
+    sphere: &lightsphere::Lightsphere,
+    radiance: &[Vec3],
+    visibility: Option<&Visibility>,
+) -> Result<usize, Error> {
+    let mut vertices = 0;
+    match visibility {
+        Some(vis) => {
+            // I_j ω_j, then c = ρ/π Σ_j M_ij (I_j ω_j).
+            let weights = sphere.light_weights(radiance)?;
+            let c = vis.matrix.radiance(&weights)?;
+            for (object, (front, back)) in objects.iter_mut().zip(&vis.rows) {
+                let scale = object.albedo / std::f32::consts::PI;
+                let take = |range: &std::ops::Range<usize>| -> Vec<Vec3> {
+                    c[range.clone()]
+                        .iter()
+                        .map(|v| {
+                            if v.is_finite() {
+                                *v * scale
+                            } else {
+                                Vec3::ZERO
+                            }
+                        })
+                        .collect()
+                };
+                let f = take(front);
+                let b = back.as_ref().map_or_else(|| f.clone(), take);
+                vertices += f.len();
+                object.front = Some(f);
+                object.back = Some(b);
+            }
+        }
+        None => {
+            for object in objects.iter_mut() {
+                let light = |normals: &[Vec3]| {
+                    crate::lighting::lambertian_radiance(
+                        normals,
+                        sphere.directions(),
+                        sphere.solid_angles(),
+                        radiance,
+                        object.albedo,
+                    )
+                };
+                let front = light(&object.normals);
+                let back = if object.two_sided {
+                    let flipped: Vec<Vec3> = object.normals.iter().map(|n| -*n).collect();
+                    light(&flipped)
+                } else {
+                    front.clone()
+                };
+                vertices += front.len();
+                object.front = Some(front);
+                object.back = Some(back);
+            }
+        }
+    }
+    Ok(vertices)
+}
