@@ -1,0 +1,131 @@
+//! The self-shadowing effect's wiring against the engine's own ambient term: under a constant
+//! environment L, c_i = (ρ/π) Σ_j M_ij L ω_j = ρ L a_i exactly, for the front rows and (for
+//! two-sided objects) the back rows; an occluder above a sheet darkens its top, not its
+//! underside.
+
+mod common;
+
+use cloth_vis::run::WorldObject;
+use cloth_vis::scene::Scene;
+use cloth_vis::shadowing::{light_objects, visibility};
+use glam::Vec3;
+use gpu_context::{GpuContext, GpuOptions};
+
+/// An n×n grid in the xz plane at height y, facing +y (counter-clockwise seen from above).
+fn sheet(n: usize, size: f32, y: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut positions = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let s = size / (n - 1) as f32;
+            positions.push(Vec3::new(
+                i as f32 * s - size / 2.0,
+                y,
+                j as f32 * s - size / 2.0,
+            ));
+        }
+    }
+    let mut triangles = Vec::new();
+    for i in 0..n - 1 {
+        for j in 0..n - 1 {
+            let a = (i * n + j) as u32;
+            let (b, c, d) = (a + 1, a + n as u32, a + n as u32 + 1);
+            triangles.push([a, b, d]);
+            triangles.push([a, d, c]);
+        }
+    }
+    (positions, triangles)
+}
+
+fn object(
+    name: &str,
+    (positions, triangles): (Vec<Vec3>, Vec<[u32; 3]>),
+    two_sided: bool,
+) -> WorldObject {
+    let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
+    WorldObject {
+        name: name.to_owned(),
+        positions,
+        normals,
+        triangles,
+        albedo: Vec3::new(0.5, 0.25, 1.0),
+        two_sided,
+        front: None,
+        back: None,
+    }
+}
+
+#[test]
+fn constant_sky_gives_albedo_times_radiance_times_ambient_on_both_sides() {
+    let gpu = match GpuContext::new(&GpuOptions::default()) {
+        Ok(g) => g,
+        Err(e) => {
+            test_data::skip::<()>(&format!("no GPU adapter: {e}"));
+            return;
+        }
+    };
+    let scene =
+        Scene::from_toml("[visibility]\nbackend = \"cpu\"\n", ".".as_ref(), "test").unwrap();
+    let mut objects = vec![
+        object("floor", sheet(9, 2.0, 0.0), true),
+        object("roof", sheet(3, 0.8, 0.3), false),
+    ];
+    let sphere = lightsphere::Lightsphere::new(3).unwrap();
+    let l = Vec3::new(2.0, 1.0, 0.5);
+    let radiance = vec![l; sphere.len()];
+    let (vis, report) = visibility(&scene, &gpu, &objects, &sphere).unwrap();
+    assert_eq!(report["backend"], "cpu");
+    light_objects(&mut objects, &sphere, &radiance, Some(&vis)).unwrap();
+
+    // Independent ambient terms from the engine, front and flipped.
+    let ambient = |normals: Vec<Vec3>| {
+        let mut occ = occlusion_gpu::Scene::new();
+        occ.push(occlusion_gpu::SceneObject::new(
+            objects[0].positions.clone(),
+            normals,
+            objects[0].triangles.clone(),
+        ))
+        .unwrap();
+        occ.push(
+            occlusion_gpu::SceneObject::new(
+                objects[1].positions.clone(),
+                objects[1].normals.clone(),
+                objects[1].triangles.clone(),
+            )
+            .occluder_only(),
+        )
+        .unwrap();
+        let mut engine =
+            occlusion_gpu::VisibilityEngine::cpu(occlusion_gpu::VisibilityParams::default());
+        engine.compute(&occ, &sphere).unwrap().ambient()
+    };
+    let top = ambient(objects[0].normals.clone());
+    let bottom = ambient(objects[0].normals.iter().map(|n| -*n).collect());
+    let rho_l = objects[0].albedo * l;
+    let front = objects[0].front.as_ref().unwrap();
+    let back = objects[0].back.as_ref().unwrap();
+    for i in 0..front.len() {
+        let tol = 1e-4 * rho_l.max_element();
+        assert!(
+            (front[i] - rho_l * top[i]).abs().max_element() < tol,
+            "front {i}: {} vs {}",
+            front[i],
+            rho_l * top[i]
+        );
+        assert!(
+            (back[i] - rho_l * bottom[i]).abs().max_element() < tol,
+            "back {i}: {} vs {}",
+            back[i],
+            rho_l * bottom[i]
+        );
+    }
+    // The centre of the floor lies under the roof: darker on top than at the open corner, and
+    // its underside is open (a ≈ 1).
+    let centre = 4 * 9 + 4;
+    assert!(
+        top[centre] < 0.8 * top[0],
+        "centre {} corner {}",
+        top[centre],
+        top[0]
+    );
+    assert!(bottom[centre] > 0.95, "underside {}", bottom[centre]);
+}
