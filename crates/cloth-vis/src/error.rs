@@ -26,6 +26,14 @@ pub enum Error {
         /// The crate that will provide it.
         provider: &'static str,
     },
+    /// A command's request cannot be carried out (bad option value for this input).
+    #[error("{path}: {message}")]
+    Request {
+        /// The file or folder concerned.
+        path: PathBuf,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
     /// Reading or writing a file failed.
     #[error("{path}: {reason}")]
     Io {

@@ -38,6 +38,36 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Visibility matrix M and ambient term a_i of a mesh or an animation (paper 000).
+    Visibility {
+        /// A mesh (.ply .obj .gltf .glb) or an animation (folder of numbered .obj, .npy, .glb).
+        input: PathBuf,
+        /// Lightsphere level s (k = 2 + 4^(s+1) directions).
+        #[arg(long, default_value_t = 3)]
+        level: u32,
+        /// Backend: depth (GPU depth maps) or cpu (exact ray casting); default depth on a
+        /// hardware GPU, cpu otherwise.
+        #[arg(long, value_parser = ["depth", "cpu"])]
+        backend: Option<String>,
+        /// Depth-map side for the depth backend.
+        #[arg(long, default_value_t = occlusion_gpu::DEFAULT_DEPTH_RESOLUTION)]
+        depth_res: u32,
+        /// HDR environment (.hdr/.exr) for the colours of a .ply output.
+        #[arg(long, conflicts_with = "sky")]
+        env: Option<PathBuf>,
+        /// Use the procedural sky for the colours of a .ply output.
+        #[arg(long)]
+        sky: bool,
+        /// Output: .npy (a_i as f32 [N] or [F, N]; M as [N, k] with --matrix) or .ply.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Write the matrix M instead of a_i.
+        #[arg(long)]
+        matrix: bool,
+        /// Frames A..B of an animation (end exclusive).
+        #[arg(long, value_parser = parse_range)]
+        frames: Option<(usize, usize)>,
+    },
     /// Load a mesh or an animation and print what the loader found (counts, quirks, time).
     Inspect {
         /// A mesh (.ply .obj .gltf .glb), an animation (.glb, .npy, a folder of numbered .obj).
@@ -87,8 +117,72 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             write!(std::io::stdout().lock(), "{}", output.report.table())?;
         }
         Command::Inspect { input, animation } => inspect(&input, animation)?,
+        Command::Visibility {
+            input,
+            level,
+            backend,
+            depth_res,
+            env,
+            sky,
+            out,
+            matrix,
+            frames,
+        } => {
+            let environment = match (env, sky) {
+                (Some(path), _) => Some(lightsphere::Environment::load(&path)?),
+                (None, true) => {
+                    let s = synth::sky(&synth::SkyParams::default())?;
+                    Some(lightsphere::Environment::from_latlong(
+                        s.width, s.height, s.texels,
+                    )?)
+                }
+                (None, false) => None,
+            };
+            let backend = backend.map(|b| {
+                if b == "cpu" {
+                    occlusion_gpu::Backend::Cpu
+                } else {
+                    occlusion_gpu::Backend::Depth
+                }
+            });
+            let gpu = match backend {
+                Some(occlusion_gpu::Backend::Cpu) => None,
+                Some(_) => Some(gpu_context::GpuContext::new(
+                    &gpu_context::GpuOptions::default(),
+                )?),
+                None => gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()).ok(),
+            };
+            let request = cloth_vis::visibility_cmd::VisibilityRequest {
+                input,
+                level,
+                backend,
+                depth_resolution: depth_res,
+                environment,
+                out,
+                matrix,
+                frames,
+            };
+            let summary = cloth_vis::visibility_cmd::run_visibility(&request, gpu.as_ref())?;
+            writeln!(std::io::stdout().lock(), "{}", summary.line())?;
+        }
     }
     Ok(())
+}
+
+/// Parse `A..B` (end exclusive).
+fn parse_range(text: &str) -> Result<(usize, usize), String> {
+    let (a, b) = text
+        .split_once("..")
+        .ok_or_else(|| format!("{text:?} is not A..B"))?;
+    let a = a
+        .trim()
+        .parse::<usize>()
+        .map_err(|e| format!("{a:?}: {e}"))?;
+    let b = b
+        .trim()
+        .parse::<usize>()
+        .map_err(|e| format!("{b:?}: {e}"))?;
+    Ok((a, b))
 }
 
 fn inspect(input: &Path, animation: bool) -> anyhow::Result<()> {

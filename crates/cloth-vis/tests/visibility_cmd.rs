@@ -1,0 +1,117 @@
+//! `cloth-vis visibility` end to end on the cpu backend (no GPU needed): array shapes, NaN for
+//! vertices used by no face, a PLY that our own loader reads back, and refusals before work.
+
+use cloth_vis::Error;
+use cloth_vis::visibility_cmd::{VisibilityRequest, run_visibility};
+
+/// A 5×5 grid facing +y, plus one vertex used by no face (index 25).
+fn grid_obj(dir: &std::path::Path) -> std::path::PathBuf {
+    let mut text = String::new();
+    for i in 0..5 {
+        for j in 0..5 {
+            text.push_str(&format!("v {} 0 {}\n", i as f32 * 0.25, j as f32 * 0.25));
+        }
+    }
+    text.push_str("v 9 9 9\n");
+    for i in 0..4 {
+        for j in 0..4 {
+            let a = i * 5 + j + 1;
+            text.push_str(&format!(
+                "f {} {} {}\nf {} {} {}\n",
+                a,
+                a + 1,
+                a + 6,
+                a,
+                a + 6,
+                a + 5
+            ));
+        }
+    }
+    let path = dir.join("grid.obj");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn request(input: std::path::PathBuf, out: Option<std::path::PathBuf>) -> VisibilityRequest {
+    VisibilityRequest {
+        input,
+        level: 2,
+        backend: Some(occlusion_gpu::Backend::Cpu),
+        depth_resolution: 256,
+        environment: None,
+        out,
+        matrix: false,
+        frames: None,
+    }
+}
+
+#[test]
+fn ambient_npy_keeps_vertex_order_with_nan_for_unused_vertices() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("a.npy");
+    let summary = run_visibility(&request(grid_obj(dir.path()), Some(out.clone())), None).unwrap();
+    assert_eq!(
+        (summary.directions, summary.vertices, summary.frames),
+        (66, 26, 1)
+    );
+    assert!(
+        summary
+            .line()
+            .starts_with("visibility: 66 directions x 26 vertices in "),
+        "{}",
+        summary.line()
+    );
+    let array = meshio::read_npy_f32(&out).unwrap();
+    assert_eq!(array.shape, vec![26]);
+    // An open plane: every used vertex sees its whole upper hemisphere (a = Σ ω max(0, n·l)/π ≈ 1).
+    for a in &array.data[..25] {
+        assert!((a - 1.0).abs() < 0.05, "{a}");
+    }
+    assert!(array.data[25].is_nan());
+
+    let mut with_matrix = request(grid_obj(dir.path()), Some(dir.path().join("m.npy")));
+    with_matrix.matrix = true;
+    run_visibility(&with_matrix, None).unwrap();
+    let m = meshio::read_npy_f32(&dir.path().join("m.npy")).unwrap();
+    assert_eq!(m.shape, vec![26, 66]);
+    // Row sums weighted by ω reproduce a_i: check the first vertex.
+    let sphere = lightsphere::Lightsphere::new(2).unwrap();
+    let a0: f64 = m.data[..66]
+        .iter()
+        .zip(sphere.solid_angles())
+        .map(|(v, w)| f64::from(*v) * w)
+        .sum::<f64>()
+        / std::f64::consts::PI;
+    assert!((a0 as f32 - array.data[0]).abs() < 1e-5);
+}
+
+#[test]
+fn ply_output_reads_back_with_the_same_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("ao.ply");
+    run_visibility(&request(grid_obj(dir.path()), Some(out.clone())), None).unwrap();
+    let (mesh, report) = meshio::load_mesh(&out, &meshio::LoadOptions::default()).unwrap();
+    assert_eq!((mesh.vertex_count(), mesh.triangle_count()), (26, 32));
+    assert_eq!(report.unreferenced_vertices, vec![25]);
+}
+
+#[test]
+fn bad_requests_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = grid_obj(dir.path());
+    let glb = dir.path().join("out.glb");
+    let err = run_visibility(&request(input.clone(), Some(glb.clone())), None).unwrap_err();
+    assert!(
+        matches!(err, Error::Request { .. }) && err.to_string().contains("out.glb"),
+        "{err}"
+    );
+    assert!(!glb.exists());
+    let mut frames = request(input.clone(), None);
+    frames.frames = Some((0, 2));
+    let err = run_visibility(&frames, None).unwrap_err().to_string();
+    assert!(err.contains("0..2") && err.contains("1 frames"), "{err}");
+    let mut depth = request(input, None);
+    depth.backend = Some(occlusion_gpu::Backend::Depth);
+    let err = run_visibility(&depth, None).unwrap_err().to_string();
+    assert!(err.contains("--backend cpu"), "{err}");
+}
