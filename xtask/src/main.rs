@@ -3,7 +3,10 @@
 //! - `cargo xtask repro lightsphere`: what each lightsphere level and I_j method costs in time
 //!   and buys in accuracy, on every HDR map in `../shared/data/env` and the procedural sky
 //!   (`target/repro/lightsphere.md` and `lightsphere.svg`).
+//! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
+//!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 
+mod compare_clustering;
 mod plot;
 mod repro_lightsphere;
 
@@ -24,6 +27,21 @@ enum Command {
     Repro {
         #[command(subcommand)]
         what: Repro,
+    },
+    /// Compare a crate with the tools users would pick instead, on the same data.
+    Compare {
+        #[command(subcommand)]
+        what: Compare,
+    },
+}
+
+#[derive(Subcommand)]
+enum Compare {
+    /// PCA, k-means and local PCA against scikit-learn (time and quality).
+    Clustering {
+        /// One seed instead of five.
+        #[arg(long)]
+        quick: bool,
     },
 }
 
@@ -49,5 +67,11 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Lightsphere { max_level },
         } => repro_lightsphere::run(&repro_dir()?, max_level),
+        Command::Compare {
+            what: Compare::Clustering { quick },
+        } => {
+            let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+            compare_clustering::run_comparison(&root, quick)
+        }
     }
 }
