@@ -33,4 +33,4 @@ mod offscreen;
 pub use adapter::{ADAPTER_ENV, AdapterSummary, BACKEND_ENV, GpuContext, GpuOptions};
 pub use error::GpuError;
 pub use image_out::{HdrImage, Tonemap};
-pub use offscreen::{COLOR_FORMAT, DEPTH_FORMAT, OffscreenTarget};
+pub use offscreen::{COLOR_FORMAT, DEPTH_FORMAT, OffscreenTarget, read_buffer};

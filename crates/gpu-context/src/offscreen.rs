@@ -177,6 +177,44 @@ fn read_texture(
         },
     );
     queue.submit([encoder.finish()]);
+    let mapped = map_read(device, &buffer)?;
+    let mut out = Vec::with_capacity(row_bytes as usize * height as usize);
+    for row in mapped.chunks_exact(padded_row as usize) {
+        out.extend_from_slice(&row[..row_bytes as usize]);
+    }
+    Ok(out)
+}
+
+/// Copy the first `size` bytes of `buffer` (which needs `COPY_SRC` usage) to the CPU: one copy
+/// into a staging buffer, one map, one blocking wait.
+///
+/// # Errors
+/// [`GpuError::Readback`] when mapping fails or the device is lost.
+pub fn read_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+    size: u64,
+) -> Result<Vec<u8>, GpuError> {
+    if size == 0 {
+        return Ok(Vec::new());
+    }
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("read-back"),
+        size,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("read-back"),
+    });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+    queue.submit([encoder.finish()]);
+    map_read(device, &staging)
+}
+
+/// Map a `MAP_READ` buffer whose copy has been submitted, wait, and return its bytes.
+fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
     let slice = buffer.slice(..);
     let (sender, receiver) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |result| {
@@ -193,11 +231,8 @@ fn read_texture(
     let mapped = slice
         .get_mapped_range()
         .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let mut out = Vec::with_capacity(row_bytes as usize * height as usize);
-    for row in mapped.chunks_exact(padded_row as usize) {
-        out.extend_from_slice(&row[..row_bytes as usize]);
-    }
+    let bytes = mapped.to_vec();
     drop(mapped);
     buffer.unmap();
-    Ok(out)
+    Ok(bytes)
 }

@@ -11,7 +11,6 @@
 //! acne at grazing angles.
 
 mod light;
-mod readback;
 
 use glam::Vec3;
 use wgpu::util::DeviceExt;
@@ -483,7 +482,8 @@ impl DepthRun {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
     ) -> Result<Vec<f32>, OcclusionError> {
-        let bytes = readback::read_buffer(device, queue, &self.ambient, self.rows as u64 * 4)?;
+        let bytes = gpu_context::read_buffer(device, queue, &self.ambient, self.rows as u64 * 4)
+            .map_err(|e| OcclusionError::Readback(e.to_string()))?;
         let mut ambient: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
         for (a, &zero) in ambient.iter_mut().zip(&self.zero_normals) {
             if zero {
@@ -507,7 +507,8 @@ impl DepthRun {
             "layout mismatch"
         );
         let size = (self.rows * self.words_per_row * 4) as u64;
-        let bytes = readback::read_buffer(device, queue, &self.bits, size)?;
+        let bytes = gpu_context::read_buffer(device, queue, &self.bits, size)
+            .map_err(|e| OcclusionError::Readback(e.to_string()))?;
         let words: Vec<u32> = bytemuck::pod_collect_to_vec(&bytes);
         let k = matrix.directions_len();
         let target = matrix.bits_mut();
