@@ -297,6 +297,18 @@ pub enum MeshIoError {
         actual: usize,
     },
 
+    /// Data given to a writer ([`crate::write_glb`], [`crate::write_glb_animation`]) is
+    /// inconsistent or not representable; nothing was written.
+    #[error("{}: cannot write {element}: {problem}; nothing was written", path.display())]
+    InvalidWriteInput {
+        /// The target file.
+        path: PathBuf,
+        /// What is wrong, e.g. `"triangle 3"`, `"COLOR_0 of vertex 7"`, `"attribute \"AO\""`.
+        element: String,
+        /// The offending value and how to fix it.
+        problem: String,
+    },
+
     /// An option has a value the loader cannot use.
     #[error("{}: option {option} = {value} is invalid: {message}", path.display())]
     InvalidOption {

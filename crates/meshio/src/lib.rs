@@ -1,5 +1,6 @@
 //! Validated loading of static meshes (PLY, OBJ, glTF) and mesh animations (glTF skinning and
-//! morph targets, folders of numbered OBJ frames, `.npy` arrays), and `.npy` output.
+//! morph targets, folders of numbered OBJ frames, `.npy` arrays), and `.npy` and glTF binary
+//! (`.glb`) output.
 //!
 //! Every other cloth-vis crate reads its geometry through this one. The seeds fix what that
 //! geometry is: the ambient-occlusion method starts from "a triangle mesh with vertex normals"
@@ -24,6 +25,11 @@
 //! | folder of numbered `.obj` frames | | ✓ (numeric order, parallel parse) |
 //! | `.gltf` / `.glb` | rest pose of the scene | skinning + morph targets sampled at a frame rate |
 //! | `.npy` `[F, V, 3]` f32/f64 | | ✓ (triangles from [`AnimationOptions::topology`]) |
+//!
+//! Output: [`write_npy_f32`]; [`write_glb`] (a [`GlbMesh`] with normals, linear float
+//! `COLOR_0` and custom scalar attributes such as `_AO`); [`write_glb_animation`] (frames as
+//! morph targets driven by a `STEP` weights clip, read back by [`load_animation`]). All writers
+//! validate first and write atomically ([`write_atomic`]).
 //!
 //! # Examples
 //! ```
@@ -60,7 +66,9 @@ use std::path::Path;
 
 pub use atomic::write_atomic;
 pub use error::MeshIoError;
-pub use gltf::MAX_VIEWLESS_ELEMENTS;
+pub use gltf::{
+    GlbMesh, MAX_VIEWLESS_ELEMENTS, NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation,
+};
 pub use normals::{compute_normals, compute_normals_into};
 pub use npy::{NpyArray, read_npy_f32, write_npy_f32};
 pub use options::{

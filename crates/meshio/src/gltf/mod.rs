@@ -17,6 +17,7 @@ mod pose;
 mod rig;
 mod sampler;
 mod source;
+mod write;
 
 use std::path::Path;
 
@@ -26,6 +27,7 @@ pub use accessor::MAX_VIEWLESS_ELEMENTS;
 use rig::Rig;
 use sampler::Clip;
 use source::GltfSource;
+pub use write::{GlbMesh, NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation};
 
 use crate::validate::{RawMesh, finish_animation, finish_mesh};
 use crate::{
