@@ -3,8 +3,8 @@
 
 use lightsphere::Lightsphere;
 
-use crate::cpu::{CpuParams, CpuTracer, compute_columns};
-use crate::gpu::{DepthParams, DepthPipelines};
+use crate::cpu::{CpuParams, Tracer, compute_columns};
+use crate::gpu::{DepthParams, DepthPipelines, DepthRun, GpuVisibility, QueryPipelines};
 use crate::scene::Prepared;
 use crate::{OcclusionError, Scene, VisibilityMatrix};
 
@@ -16,6 +16,11 @@ pub enum Backend {
     /// GPU: orthographic depth maps per direction, then a compute pass that depth-tests every
     /// vertex against them with a slope-scaled bias (the seed's future work, §8.1).
     Depth,
+    /// GPU, as published (§3.2, Figure 2): per direction the scene into a depth map, then
+    /// every vertex drawn as a point inside its own hardware occlusion query; the query
+    /// results are resolved and packed into M on the GPU. Slow by nature (N·k draws): the
+    /// published baseline. Uses the [`DepthParams`] knobs of `depth`.
+    Query,
 }
 
 impl Backend {
@@ -24,6 +29,7 @@ impl Backend {
         match self {
             Self::Cpu => "cpu",
             Self::Depth => "depth",
+            Self::Query => "query",
         }
     }
 }
@@ -34,7 +40,7 @@ impl Backend {
 pub struct VisibilityParams {
     /// `cpu` backend knobs.
     pub cpu: CpuParams,
-    /// `depth` backend knobs.
+    /// `depth` backend knobs, also used by `query` (resolution, bias, normal offset).
     pub depth: DepthParams,
 }
 
@@ -56,6 +62,7 @@ struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipelines: Option<DepthPipelines>,
+    query: Option<QueryPipelines>,
 }
 
 /// Computes visibility matrices with a chosen backend.
@@ -64,6 +71,9 @@ pub struct VisibilityEngine {
     params: VisibilityParams,
     gpu: Option<Gpu>,
     last_rays: u64,
+    /// The `cpu` backend's BVH of the last scene, reused while the geometry is unchanged
+    /// (refinement, vertex filtering on a static mesh, an idle scene).
+    cpu_tracer: Option<Tracer>,
 }
 
 impl VisibilityEngine {
@@ -74,6 +84,7 @@ impl VisibilityEngine {
             params,
             gpu: None,
             last_rays: 0,
+            cpu_tracer: None,
         }
     }
 
@@ -92,8 +103,10 @@ impl VisibilityEngine {
                 device: device.clone(),
                 queue: queue.clone(),
                 pipelines: None,
+                query: None,
             }),
             last_rays: 0,
+            cpu_tracer: None,
         }
     }
 
@@ -155,8 +168,50 @@ impl VisibilityEngine {
         self.fill(&prepared, matrix, first_new)
     }
 
-    /// The ambient term a_i only. On the `depth` backend it is accumulated on the GPU and
-    /// only N floats are read back; on `cpu` it is derived from M.
+    /// (Re)computes only the receiver rows `rows` of `matrix`, for all of its directions, with
+    /// this engine's backend: every triangle of `scene` still occludes, only the listed
+    /// vertices are tested (paper 000 §4.1, vertex filtering). The rows' normals are updated
+    /// from `scene` too (a deforming mesh); rows not listed are left as they are. The result
+    /// of a listed row is bit-identical to the same row of [`VisibilityEngine::compute`].
+    /// Duplicate indices are allowed (computed twice); an empty list does nothing.
+    ///
+    /// # Errors
+    /// [`OcclusionError::RowCountMismatch`] when the scene's receiver count differs from the
+    /// matrix's rows, [`OcclusionError::RowOutOfRange`] for an index ≥ the row count, and the
+    /// errors of [`VisibilityEngine::compute`].
+    pub fn compute_rows(
+        &mut self,
+        scene: &Scene,
+        matrix: &mut VisibilityMatrix,
+        rows: &[u32],
+    ) -> Result<(), OcclusionError> {
+        let prepared = Prepared::new(scene)?;
+        if prepared.receivers.len() != matrix.rows() {
+            return Err(OcclusionError::RowCountMismatch {
+                matrix: matrix.rows(),
+                scene: prepared.receivers.len(),
+            });
+        }
+        if let Some(&row) = rows.iter().find(|&&r| r as usize >= matrix.rows()) {
+            return Err(OcclusionError::RowOutOfRange {
+                row,
+                rows: matrix.rows(),
+            });
+        }
+        self.last_rays = 0;
+        if rows.is_empty() {
+            return Ok(());
+        }
+        let subset = prepared.with_receivers(rows);
+        let normals = subset.receivers.iter().map(|r| r.normal).collect();
+        let mut compact = matrix.zeros_like(normals);
+        self.fill(&subset, &mut compact, 0)?;
+        matrix.scatter_rows(&compact, rows);
+        Ok(())
+    }
+
+    /// The ambient term a_i only. On the `depth` and `query` backends it is accumulated on the
+    /// GPU and only N floats are read back; on `cpu` it is derived from M.
     ///
     /// # Errors
     /// As [`VisibilityEngine::compute`].
@@ -167,38 +222,111 @@ impl VisibilityEngine {
     ) -> Result<Vec<f32>, OcclusionError> {
         match self.backend {
             Backend::Cpu => Ok(self.compute(scene, sphere)?.ambient()),
-            Backend::Depth => {
+            Backend::Depth | Backend::Query => {
                 let prepared = Prepared::new(scene)?;
-                let params = self.params.depth;
-                let (gpu, pipelines) = self.gpu_pipelines()?;
-                let run = pipelines.run(
-                    &gpu.device,
-                    &gpu.queue,
-                    &prepared,
-                    sphere.directions(),
-                    sphere.solid_angles(),
-                    0,
-                    &params,
-                )?;
+                let (gpu, run) =
+                    self.run_gpu(&prepared, sphere.directions(), sphere.solid_angles(), 0)?;
                 run.read_ambient(&gpu.device, &gpu.queue)
             }
         }
     }
 
-    fn gpu_pipelines(&mut self) -> Result<(&Gpu, &DepthPipelines), OcclusionError> {
-        let backend = self.backend.name();
-        let gpu = self
-            .gpu
-            .as_mut()
-            .ok_or(OcclusionError::NoDevice { backend })?;
+    /// Computes the full visibility matrix and a_i on the GPU and keeps them there: M stays
+    /// on the GPU from frame to frame; only what is asked for is read back (paper 000 §8.1).
+    /// [`GpuVisibility::read_matrix`] equals [`VisibilityEngine::compute`] and
+    /// [`GpuVisibility::read_ambient`] equals [`VisibilityEngine::ambient`].
+    ///
+    /// # Errors
+    /// [`OcclusionError::NotGpuResident`] on the `cpu` backend, and the errors of
+    /// [`VisibilityEngine::compute`].
+    ///
+    /// # Examples
+    /// ```no_run
+    /// # use occlusion_gpu::{Backend, Scene, VisibilityEngine, VisibilityParams};
+    /// # fn demo(
+    /// #     device: &wgpu::Device,
+    /// #     queue: &wgpu::Queue,
+    /// #     scene: &Scene,
+    /// # ) -> Result<(), Box<dyn std::error::Error>> {
+    /// let sphere = lightsphere::Lightsphere::new(2)?;
+    /// let params = VisibilityParams::default();
+    /// let mut engine = VisibilityEngine::with_gpu(device, queue, Backend::Query, params);
+    /// let resident = engine.compute_resident(scene, &sphere)?;
+    /// // A renderer binds resident.bits_buffer() and resident.ambient_buffer() directly;
+    /// // read back only what is needed:
+    /// let ambient = resident.read_ambient()?;
+    /// assert_eq!(ambient.len(), resident.rows());
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn compute_resident(
+        &mut self,
+        scene: &Scene,
+        sphere: &Lightsphere,
+    ) -> Result<GpuVisibility, OcclusionError> {
+        if self.backend == Backend::Cpu {
+            return Err(OcclusionError::NotGpuResident {
+                backend: self.backend.name(),
+            });
+        }
+        let prepared = Prepared::new(scene)?;
+        self.last_rays = 0;
+        let (gpu, run) = self.run_gpu(&prepared, sphere.directions(), sphere.solid_angles(), 0)?;
+        let normals = prepared.receivers.iter().map(|r| r.normal).collect();
+        Ok(GpuVisibility::new(
+            run,
+            &gpu.device,
+            &gpu.queue,
+            sphere,
+            normals,
+        ))
+    }
+
+    /// Runs the GPU backend in use for the columns `first..k` (pipelines built on first use);
+    /// the results stay on the GPU.
+    fn run_gpu(
+        &mut self,
+        prepared: &Prepared,
+        directions: &[glam::Vec3],
+        solid_angles: &[f64],
+        first: usize,
+    ) -> Result<(&Gpu, DepthRun), OcclusionError> {
+        let backend = self.backend;
+        let params = self.params.depth;
+        let gpu = self.gpu.as_mut().ok_or(OcclusionError::NoDevice {
+            backend: backend.name(),
+        })?;
         if gpu.pipelines.is_none() {
             gpu.pipelines = Some(DepthPipelines::new(&gpu.device));
         }
-        let gpu = &*gpu;
-        match &gpu.pipelines {
-            Some(pipelines) => Ok((gpu, pipelines)),
-            None => unreachable!("pipelines were just built"),
+        if backend == Backend::Query && gpu.query.is_none() {
+            gpu.query = Some(QueryPipelines::new(&gpu.device));
         }
+        let gpu = &*gpu;
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let run = match (backend, &gpu.pipelines, &gpu.query) {
+            (Backend::Depth, Some(depth), _) => depth.run(
+                device,
+                queue,
+                prepared,
+                directions,
+                solid_angles,
+                first,
+                &params,
+            )?,
+            (Backend::Query, Some(depth), Some(query)) => query.run(
+                depth,
+                device,
+                queue,
+                prepared,
+                directions,
+                solid_angles,
+                first,
+                &params,
+            )?,
+            _ => unreachable!("pipelines of {} were just built", backend.name()),
+        };
+        Ok((gpu, run))
     }
 
     /// Computes the columns `first_new..k` of `matrix`.
@@ -215,12 +343,22 @@ impl VisibilityEngine {
         }
         match self.backend {
             Backend::Cpu => {
-                let tracer = CpuTracer::new(prepared);
+                let method = self.params.cpu.method;
+                if !self
+                    .cpu_tracer
+                    .as_ref()
+                    .is_some_and(|t| t.fits(prepared, method))
+                {
+                    self.cpu_tracer = Some(Tracer::new(prepared, method));
+                }
+                let Some(tracer) = &self.cpu_tracer else {
+                    unreachable!("the tracer was just built")
+                };
                 let words_per_row = matrix.words_per_row();
                 let directions = matrix.directions().to_vec();
                 self.last_rays = compute_columns(
                     prepared,
-                    &tracer,
+                    tracer,
                     &directions,
                     first_new..k,
                     &self.params.cpu,
@@ -229,20 +367,10 @@ impl VisibilityEngine {
                 );
                 Ok(())
             }
-            Backend::Depth => {
-                let params = self.params.depth;
+            Backend::Depth | Backend::Query => {
                 let directions = matrix.directions().to_vec();
                 let solid_angles = matrix.solid_angles().to_vec();
-                let (gpu, pipelines) = self.gpu_pipelines()?;
-                let run = pipelines.run(
-                    &gpu.device,
-                    &gpu.queue,
-                    prepared,
-                    &directions,
-                    &solid_angles,
-                    first_new,
-                    &params,
-                )?;
+                let (gpu, run) = self.run_gpu(prepared, &directions, &solid_angles, first_new)?;
                 run.read_bits_into(&gpu.device, &gpu.queue, matrix, first_new)
             }
         }

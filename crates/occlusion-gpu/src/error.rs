@@ -92,6 +92,36 @@ pub enum OcclusionError {
         /// Directions of the matrix.
         expected: usize,
     },
+    /// A matrix row index passed to [`crate::VisibilityEngine::compute_rows`] does not exist.
+    #[error(
+        "row {row} is out of range: the visibility matrix has {rows} rows; pass receiver rows < {rows}"
+    )]
+    RowOutOfRange {
+        /// The offending row index.
+        row: u32,
+        /// Rows of the matrix.
+        rows: usize,
+    },
+    /// An array given to the vertex filter or level controller has the wrong length.
+    #[error("{what} has {given} entries but {expected} were expected; rebuild it for this scene")]
+    SizeMismatch {
+        /// Which array.
+        what: &'static str,
+        /// Entries given.
+        given: usize,
+        /// Entries expected.
+        expected: usize,
+    },
+    /// A parameter of the vertex filter, camera or level controller is out of its range.
+    #[error("{what} = {value} is invalid; it must be {expected}")]
+    InvalidParameter {
+        /// Which parameter.
+        what: &'static str,
+        /// The value given.
+        value: f64,
+        /// The valid range, in words.
+        expected: &'static str,
+    },
     /// A GPU backend was asked for without a device.
     #[error("backend {backend} needs a wgpu device and queue; use VisibilityEngine::with_gpu")]
     NoDevice {
@@ -108,7 +138,19 @@ pub enum OcclusionError {
         /// The device's maximum.
         maximum: u64,
     },
+    /// A GPU-resident result was asked of a backend that computes M on the CPU.
+    #[error(
+        "backend {backend} computes M on the CPU and has no GPU-resident result; use the depth \
+         or query backend with VisibilityEngine::with_gpu"
+    )]
+    NotGpuResident {
+        /// The backend's name.
+        backend: &'static str,
+    },
     /// Reading results back from the GPU failed.
     #[error("GPU read-back failed: {0}")]
     Readback(String),
+    /// Light look-up failed (a rotation that cannot be normalised, a bad prefilter σ).
+    #[error("lighting: {0}")]
+    Lighting(#[from] lightsphere::LightsphereError),
 }

@@ -14,21 +14,42 @@
 //! Backends ([`Backend`]):
 //! * `Cpu` — exact ray casting, the accuracy reference: one shadow ray per (vertex,
 //!   direction) with n·l > 0 from the vertex pushed 1e-4 × the bounding-box diagonal along its
-//!   normal, any-hit traversal of `obvhs`'s compressed 8-wide BVH, multi-threaded with rayon.
-//!   `obvhs` was chosen over `bvh` 0.13 for its early-exit shadow-ray traversal
-//!   (`ray_traverse_miss`) over 8-wide compressed nodes (`bvh` collects candidates per ray
-//!   over a binary tree); see `benches/visibility.rs` for rays/s.
+//!   normal, multi-threaded with rayon. By default the rays of 64 neighbouring vertices towards
+//!   one direction walk an `obvhs` binary BVH together as a packet ([`CpuMethod`]); see
+//!   `benches/visibility.rs` for rays/s.
 //! * `Depth` — the seed's future work (§8.1) on the GPU: orthographic Depth32Float maps per
 //!   direction in batches of 2D-array layers, then a compute pass depth-tests every vertex with
 //!   a slope-scaled bias (the counterpart of `glPolygonOffset(1, 1)`), writing visibility bits
 //!   and accumulating a_i in storage buffers; only what is asked for is read back.
+//! * `Query` — the published algorithm (§3.2, Figure 2): per direction the scene into an
+//!   orthographic depth map, then every vertex drawn as a point (depth test LessEqual, no
+//!   depth write) inside its own hardware occlusion query; a vertex with a sample passing is
+//!   visible, M_ij = n_i·l_j. The bias of `glPolygonOffset(1, 1)` is applied in the vertex
+//!   shader with the `Depth` backend's formula, so the two GPU backends agree (bit-identical
+//!   on lavapipe). Unlike the seed, whose §8.1 names the per-query read-back as its drawback,
+//!   the query results are resolved into a GPU buffer per batch of ≤ 4096-query sets and
+//!   packed into the same bits and a_i buffers by a compute pass: no stall, no read-back per
+//!   query. Slow by nature (N·k draws): the published baseline.
 //!
-//! The published `query` backend (one hardware occlusion query per vertex) is not
-//! implemented yet.
+//! Both GPU backends can keep their result on the GPU:
+//! [`VisibilityEngine::compute_resident`] returns a [`GpuVisibility`] whose bits and a_i
+//! buffers a renderer binds directly — M stays on the GPU from frame to frame, and only what
+//! is asked for is read back (§8.1).
+//!
+//! A single rigidly rotating object needs no recompute: [`RigidLighting`] looks the
+//! environment up in the rotated light directions (§6).
 //!
 //! Several objects with transforms occlude each other ([`Scene`], [`SceneObject`]); only
 //! receiver objects get matrix rows, in object and vertex order. A vertex with a zero normal
 //! (used by no triangle) has an all-zero row and a_i = c_i = NaN.
+//!
+//! Per-frame savings (paper 000 §4): *vertex filtering* ([`FilteredVisibility`],
+//! [`VertexFilter`], §4.1) computes only the rows of vertices of triangles seen for the first
+//! time ([`VisibilityEngine::compute_rows`]), found by a triangle-id pass from the camera
+//! ([`TriangleIdRenderer`], or [`visible_triangles_cpu`] without an adapter); a deforming mesh
+//! re-initialises the unseen list each frame (§6), so it computes exactly the vertices of the
+//! visible triangles. The *adaptive level* ([`LevelController`], §4.2) picks the lightsphere
+//! level per animated frame from a target frame time and refines one level at a time when idle.
 //!
 //! # Examples
 //! ```
@@ -53,16 +74,30 @@
 mod cpu;
 mod engine;
 mod error;
+mod filter;
 mod gpu;
+mod level;
 mod matrix;
+mod rigid;
 mod scene;
 
-pub use cpu::{CpuParams, DEFAULT_OFFSET_RELATIVE};
+pub use cpu::{CpuMethod, CpuParams, DEFAULT_OFFSET_RELATIVE};
 pub use engine::{Backend, VisibilityEngine, VisibilityParams};
 pub use error::OcclusionError;
+pub use filter::{
+    Camera, DEFAULT_FILTER_THRESHOLD_FRACTION, FilterParams, FilterThreshold, FilteredVisibility,
+    FrameStats, TriangleIdRenderer, TriangleSet, TriangleVisibility, VertexFilter, triangle_rows,
+    visible_triangles_cpu,
+};
 pub use gpu::{
     DEFAULT_BIAS_CONSTANT_TEXELS, DEFAULT_BIAS_SLOPE_TEXELS, DEFAULT_DEPTH_RESOLUTION,
     DEFAULT_MAX_ARRAY_BYTES, DEFAULT_MAX_SLOPE, DEFAULT_NORMAL_OFFSET_TEXELS, DepthParams,
+    GpuVisibility,
+};
+pub use level::{
+    DEFAULT_MAX_IDLE_LEVEL, DEFAULT_MAX_LEVEL, DEFAULT_MIN_LEVEL, DEFAULT_RISE_AFTER_FRAMES,
+    DEFAULT_RISE_FRACTION, LevelChange, LevelController, LevelParams,
 };
 pub use matrix::VisibilityMatrix;
+pub use rigid::RigidLighting;
 pub use scene::{MAX_ELEMENTS, Scene, SceneObject};

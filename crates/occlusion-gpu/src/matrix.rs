@@ -206,3 +206,34 @@ impl VisibilityMatrix {
         })
     }
 }
+
+/// Row-subset helpers of [`crate::VisibilityEngine::compute_rows`] (crate-internal: the
+/// matrix's fields are private to this module).
+impl VisibilityMatrix {
+    /// An all-occluded matrix with this matrix's directions and weights and one row per
+    /// normal.
+    pub(crate) fn zeros_like(&self, normals: Vec<Vec3>) -> Self {
+        Self {
+            rows: normals.len(),
+            words_per_row: self.words_per_row,
+            bits: vec![0; normals.len() * self.words_per_row],
+            normals,
+            directions: self.directions.clone(),
+            weights: self.weights.clone(),
+        }
+    }
+
+    /// Copies row `r` of `subset` (bits and normal) into row `rows[r]` of `self`; the other
+    /// rows are left as they are.
+    pub(crate) fn scatter_rows(&mut self, subset: &Self, rows: &[u32]) {
+        assert_eq!(subset.rows, rows.len(), "one target row per subset row");
+        assert_eq!(subset.words_per_row, self.words_per_row, "same directions");
+        let w = self.words_per_row;
+        for (r, &target) in rows.iter().enumerate() {
+            let target = target as usize;
+            self.bits[target * w..(target + 1) * w]
+                .copy_from_slice(&subset.bits[r * w..(r + 1) * w]);
+            self.normals[target] = subset.normals[r];
+        }
+    }
+}

@@ -310,6 +310,16 @@ impl Prepared {
     }
 }
 
+impl Prepared {
+    /// The same scene (every triangle still occludes, same centre and bounds, so every backend
+    /// computes bit-identical rows) with only the receiver rows `rows` as matrix rows, in the
+    /// given order. The caller has checked that every index is in range.
+    pub(crate) fn with_receivers(self, rows: &[u32]) -> Self {
+        let receivers = rows.iter().map(|&r| self.receivers[r as usize]).collect();
+        Self { receivers, ..self }
+    }
+}
+
 /// Inverse transpose of the upper 3×3 (normals transform with it); falls back to the matrix
 /// itself when it is singular (a flattening scale keeps the normals' directions meaningless
 /// anyway, and they are renormalised).

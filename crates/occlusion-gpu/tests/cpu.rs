@@ -5,7 +5,9 @@ mod common;
 use common::*;
 use glam::{DVec3, Mat4, Quat, Vec3};
 use lightsphere::Lightsphere;
-use occlusion_gpu::{OcclusionError, Scene, SceneObject, VisibilityEngine, VisibilityParams};
+use occlusion_gpu::{
+    CpuMethod, CpuParams, OcclusionError, Scene, SceneObject, VisibilityEngine, VisibilityParams,
+};
 
 fn engine() -> VisibilityEngine {
     VisibilityEngine::cpu(VisibilityParams::default())
@@ -15,9 +17,16 @@ fn engine() -> VisibilityEngine {
 /// where the ray passes within float noise of a triangle edge.
 #[test]
 fn matches_brute_force_on_sphere_over_plane() {
+    for method in [CpuMethod::Packets, CpuMethod::SingleRays] {
+        let params = VisibilityParams::default().with_cpu(CpuParams::default().with_method(method));
+        matches_brute_force(VisibilityEngine::cpu(params), &format!("{method:?}"));
+    }
+}
+
+fn matches_brute_force(mut engine: VisibilityEngine, name: &str) {
     let scene = sphere_over_plane();
     let sphere = Lightsphere::new(2).unwrap();
-    let matrix = engine().compute(&scene, &sphere).unwrap();
+    let matrix = engine.compute(&scene, &sphere).unwrap();
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     let mut normals = Vec::new();
@@ -41,7 +50,7 @@ fn matches_brute_force_on_sphere_over_plane() {
             let grazing = n.dot(*l).abs() < 1e-6;
             if matrix.is_visible(i, j) != expected && !grazing {
                 if disagreements < 10 {
-                    eprintln!("differs: vertex {i} direction {j}: p {p} n {n} l {l}");
+                    eprintln!("{name} differs: vertex {i} direction {j}: p {p} n {n} l {l}");
                 }
                 disagreements += 1;
             }
@@ -51,7 +60,7 @@ fn matches_brute_force_on_sphere_over_plane() {
     // Only rays grazing an edge within f32 rounding may differ: at most 1e-4 of the entries.
     assert!(
         disagreements * 10_000 <= total,
-        "{disagreements} of {total} entries differ from brute force"
+        "{name}: {disagreements} of {total} entries differ from brute force"
     );
     assert!(
         matrix.visible_count() > total / 4,
@@ -226,4 +235,52 @@ fn bunny_res4_is_finite_and_bounded() {
     assert!(finite.iter().all(|a| (0.0..=1.05).contains(a)));
     let mean = finite.iter().sum::<f32>() / finite.len() as f32;
     assert!((0.4..0.95).contains(&mean), "mean ambient {mean}");
+}
+
+/// The packet traversal (default) and the single-ray traversal of another BVH share only the
+/// triangle test: they must give the same M up to rays grazing an edge.
+#[test]
+fn packet_and_single_ray_traversals_agree() {
+    let mut scenes = vec![("sphere over plane", sphere_over_plane())];
+    let sheet = grid(24, 2.0);
+    let mut folded = Scene::new();
+    folded.push(sheet.object()).unwrap();
+    folded
+        .push(
+            sheet
+                .object()
+                .with_transform(Mat4::from_rotation_translation(
+                    Quat::from_rotation_x(0.3),
+                    Vec3::new(0.1, 0.05, 0.0),
+                )),
+        )
+        .unwrap();
+    scenes.push(("two crossing sheets", folded));
+    if let Some(bunny) = shared_scene("meshes/bun_zipper_res4.ply") {
+        scenes.push(("bunny res4", bunny));
+    }
+    let sphere = Lightsphere::new(3).unwrap();
+    for (name, scene) in &scenes {
+        let run = |method| {
+            let params =
+                VisibilityParams::default().with_cpu(CpuParams::default().with_method(method));
+            VisibilityEngine::cpu(params)
+                .compute(scene, &sphere)
+                .unwrap()
+        };
+        let packets = run(CpuMethod::Packets);
+        let single = run(CpuMethod::SingleRays);
+        let differing = (0..packets.rows())
+            .flat_map(|i| (0..sphere.len()).map(move |j| (i, j)))
+            .filter(|&(i, j)| packets.is_visible(i, j) != single.is_visible(i, j))
+            .count();
+        // Only rays through a shared edge or vertex within f32 rounding may go either way
+        // (seen: straight-down rays through the uv-sphere's pole vertex).
+        let total = packets.rows() * sphere.len();
+        assert!(
+            differing * 10_000 <= total,
+            "{name}: {differing} of {total} entries differ"
+        );
+        assert!(packets.visible_count() > 0, "{name}: nothing visible");
+    }
 }

@@ -11,11 +11,15 @@
 //! acne at grazing angles.
 
 mod light;
+mod query;
+mod resident;
 
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 pub(crate) use light::LightBox;
+pub(crate) use query::QueryPipelines;
+pub use resident::GpuVisibility;
 
 use crate::matrix::WORD_BITS;
 use crate::scene::Prepared;
@@ -45,7 +49,9 @@ const MAX_GROUPS_PER_DIMENSION: u32 = 65_535;
 const DEPTH_SHADER: &str = include_str!("../../../../shaders/occlusion_depth.wgsl");
 const TEST_SHADER: &str = include_str!("../../../../shaders/occlusion_test.wgsl");
 
-/// Tuning knobs of the `depth` backend.
+/// Tuning knobs of the `depth` backend. The `query` backend uses the same resolution, bias
+/// and normal offset (so both GPU backends decide alike); it ignores `max_array_bytes` (one
+/// depth map at a time).
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct DepthParams {
@@ -240,19 +246,219 @@ impl DepthPipelines {
         params: &DepthParams,
     ) -> Result<DepthRun, OcclusionError> {
         let limits = device.limits();
-        let resolution = params.resolution;
-        if resolution == 0 || resolution > limits.max_texture_dimension_2d {
-            return Err(OcclusionError::GpuLimit {
-                what: "depth resolution",
-                value: u64::from(resolution),
-                maximum: u64::from(limits.max_texture_dimension_2d),
+        let resolution = check_resolution(device, params.resolution)?;
+        let k = directions.len();
+        let scene = SceneBuffers::new(device, prepared, directions, solid_angles)?;
+        let (rows, words_per_row) = (scene.rows, scene.words_per_row);
+        let layer_bytes = u64::from(resolution) * u64::from(resolution) * 4;
+        let max_layers = (params.max_array_bytes / layer_bytes)
+            .clamp(1, u64::from(limits.max_texture_array_layers)) as usize;
+        let light_box = scene.light_box;
+        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("occlusion params"),
+            size: std::mem::size_of::<TestParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let layers = max_layers.min(k - first).max(1);
+        let depth_maps = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("occlusion depth maps"),
+            size: wgpu::Extent3d {
+                width: resolution,
+                height: resolution,
+                depth_or_array_layers: layers as u32,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let layer_views: Vec<wgpu::TextureView> = (0..layers as u32)
+            .map(|layer| {
+                depth_maps.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let array_view = depth_maps.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let depth_group = self.depth_bind_group(device, &scene);
+        let test_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("occlusion test"),
+            layout: &self.test_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: scene.receiver_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: scene.light_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&array_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: scene.bits.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: scene.ambient.as_entire_binding(),
+                },
+            ],
+        });
+        let texel_world = 2.0 * light_box.half_extent / resolution as f32;
+        let groups = (rows as u32).div_ceil(WORKGROUP_SIZE);
+        let groups_x = groups.min(MAX_GROUPS_PER_DIMENSION);
+        let groups_y = groups.div_ceil(groups_x.max(1));
+        let mut first_direction = first;
+        while first_direction < k {
+            let layer_count = layers.min(k - first_direction);
+            let test_params = TestParams {
+                vertex_count: rows as u32,
+                first_direction: first_direction as u32,
+                layer_count: layer_count as u32,
+                words_per_row: words_per_row as u32,
+                resolution,
+                texel_world,
+                // The depth range (2R) equals the box width, so one texel is 1/res in depth.
+                texel_depth: 1.0 / resolution as f32,
+                bias_constant_texels: params.bias_constant_texels,
+                bias_slope_texels: params.bias_slope_texels,
+                max_slope: params.max_slope,
+                normal_offset_texels: params.normal_offset_texels,
+                _pad: 0.0,
+            };
+            queue.write_buffer(&params_buffer, 0, bytemuck::bytes_of(&test_params));
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("occlusion batch"),
             });
+            for (layer, view) in layer_views.iter().enumerate().take(layer_count) {
+                let j = (first_direction + layer) as u32;
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("occlusion depth"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                self.draw_scene(&mut pass, &depth_group, &scene, j);
+            }
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("occlusion test"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.test_pipeline);
+                pass.set_bind_group(0, &test_group, &[]);
+                pass.dispatch_workgroups(groups_x, groups_y, 1);
+            }
+            queue.submit([encoder.finish()]);
+            first_direction += layer_count;
         }
+        Ok(scene.into_run(prepared))
+    }
+
+    /// The bind group of the scene pass (the lights, indexed by the draw's instance index).
+    pub(crate) fn depth_bind_group(
+        &self,
+        device: &wgpu::Device,
+        scene: &SceneBuffers,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("occlusion depth"),
+            layout: &self.depth_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: scene.light_buffer.as_entire_binding(),
+            }],
+        })
+    }
+
+    /// Records the scene's depth-only draw as seen from direction `j` into `pass` (§3.2, first
+    /// pass); `group` comes from [`DepthPipelines::depth_bind_group`].
+    pub(crate) fn draw_scene(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        group: &wgpu::BindGroup,
+        scene: &SceneBuffers,
+        j: u32,
+    ) {
+        if scene.index_count > 0 {
+            pass.set_pipeline(&self.depth_pipeline);
+            pass.set_bind_group(0, group, &[]);
+            pass.set_vertex_buffer(0, scene.vertex_buffer.slice(..));
+            pass.set_index_buffer(scene.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..scene.index_count, 0, j..j + 1);
+        }
+    }
+}
+
+/// Checks a depth-map resolution against the device.
+pub(crate) fn check_resolution(
+    device: &wgpu::Device,
+    resolution: u32,
+) -> Result<u32, OcclusionError> {
+    let maximum = device.limits().max_texture_dimension_2d;
+    if resolution == 0 || resolution > maximum {
+        return Err(OcclusionError::GpuLimit {
+            what: "depth resolution",
+            value: u64::from(resolution),
+            maximum: u64::from(maximum),
+        });
+    }
+    Ok(resolution)
+}
+
+/// The GPU buffers both GPU backends share for one computation: lights, receivers, the
+/// scene's geometry, and the zero-initialised outputs (visibility bits, a_i).
+pub(crate) struct SceneBuffers {
+    pub light_box: LightBox,
+    pub light_buffer: wgpu::Buffer,
+    pub receiver_buffer: wgpu::Buffer,
+    pub vertex_buffer: wgpu::Buffer,
+    pub index_buffer: wgpu::Buffer,
+    pub index_count: u32,
+    pub bits: wgpu::Buffer,
+    pub ambient: wgpu::Buffer,
+    pub rows: usize,
+    pub words_per_row: usize,
+}
+
+impl SceneBuffers {
+    /// Uploads the scene and allocates the outputs for `directions.len()` columns.
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        prepared: &Prepared,
+        directions: &[Vec3],
+        solid_angles: &[f64],
+    ) -> Result<Self, OcclusionError> {
         let k = directions.len();
         let rows = prepared.receivers.len();
         let words_per_row = k.div_ceil(WORD_BITS);
         let bits_bytes = (rows * words_per_row * 4) as u64;
-        let max_binding = limits.max_storage_buffer_binding_size;
+        let max_binding = device.limits().max_storage_buffer_binding_size;
         if bits_bytes > max_binding {
             return Err(OcclusionError::GpuLimit {
                 what: "visibility bits buffer bytes",
@@ -260,10 +466,6 @@ impl DepthPipelines {
                 maximum: max_binding,
             });
         }
-        let layer_bytes = u64::from(resolution) * u64::from(resolution) * 4;
-        let max_layers = (params.max_array_bytes / layer_bytes)
-            .clamp(1, u64::from(limits.max_texture_array_layers)) as usize;
-
         let light_box = LightBox::new(prepared.radius);
         let lights = light_box.lights(directions, solid_angles);
         let receivers: Vec<[f32; 8]> = prepared
@@ -314,159 +516,38 @@ impl DepthPipelines {
             usage: readable,
             mapped_at_creation: false,
         });
-        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("occlusion params"),
-            size: std::mem::size_of::<TestParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let layers = max_layers.min(k - first).max(1);
-        let depth_maps = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("occlusion depth maps"),
-            size: wgpu::Extent3d {
-                width: resolution,
-                height: resolution,
-                depth_or_array_layers: layers as u32,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let layer_views: Vec<wgpu::TextureView> = (0..layers as u32)
-            .map(|layer| {
-                depth_maps.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: layer,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            })
-            .collect();
-        let array_view = depth_maps.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        let depth_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("occlusion depth"),
-            layout: &self.depth_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: light_buffer.as_entire_binding(),
-            }],
-        });
-        let test_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("occlusion test"),
-            layout: &self.test_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: receiver_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: light_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&array_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: bits.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: ambient.as_entire_binding(),
-                },
-            ],
-        });
-        let texel_world = 2.0 * light_box.half_extent / resolution as f32;
-        let groups = (rows as u32).div_ceil(WORKGROUP_SIZE);
-        let groups_x = groups.min(MAX_GROUPS_PER_DIMENSION);
-        let groups_y = groups.div_ceil(groups_x.max(1));
-        let index_count = indices.len() as u32;
-        let mut first_direction = first;
-        while first_direction < k {
-            let layer_count = layers.min(k - first_direction);
-            let test_params = TestParams {
-                vertex_count: rows as u32,
-                first_direction: first_direction as u32,
-                layer_count: layer_count as u32,
-                words_per_row: words_per_row as u32,
-                resolution,
-                texel_world,
-                // The depth range (2R) equals the box width, so one texel is 1/res in depth.
-                texel_depth: 1.0 / resolution as f32,
-                bias_constant_texels: params.bias_constant_texels,
-                bias_slope_texels: params.bias_slope_texels,
-                max_slope: params.max_slope,
-                normal_offset_texels: params.normal_offset_texels,
-                _pad: 0.0,
-            };
-            queue.write_buffer(&params_buffer, 0, bytemuck::bytes_of(&test_params));
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("occlusion batch"),
-            });
-            for (layer, view) in layer_views.iter().enumerate().take(layer_count) {
-                let j = (first_direction + layer) as u32;
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("occlusion depth"),
-                    color_attachments: &[],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                if index_count > 0 {
-                    pass.set_pipeline(&self.depth_pipeline);
-                    pass.set_bind_group(0, &depth_group, &[]);
-                    pass.set_vertex_buffer(0, vertex_buffer.slice(..));
-                    pass.set_index_buffer(index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(0..index_count, 0, j..j + 1);
-                }
-            }
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("occlusion test"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&self.test_pipeline);
-                pass.set_bind_group(0, &test_group, &[]);
-                pass.dispatch_workgroups(groups_x, groups_y, 1);
-            }
-            queue.submit([encoder.finish()]);
-            first_direction += layer_count;
-        }
-        Ok(DepthRun {
+        Ok(Self {
+            light_box,
+            light_buffer,
+            receiver_buffer,
+            vertex_buffer,
+            index_buffer,
+            index_count: indices.len() as u32,
             bits,
             ambient,
             rows,
             words_per_row,
+        })
+    }
+
+    /// The outputs, kept on the GPU.
+    pub(crate) fn into_run(self, prepared: &Prepared) -> DepthRun {
+        DepthRun {
+            bits: self.bits,
+            ambient: self.ambient,
+            rows: self.rows,
+            words_per_row: self.words_per_row,
             zero_normals: prepared
                 .receivers
                 .iter()
                 .map(|r| r.normal == Vec3::ZERO)
                 .collect(),
-        })
+        }
     }
 }
 
-/// The GPU-resident result of one `depth` computation: visibility bits and a_i in storage
-/// buffers, read back only on request.
+/// The GPU-resident result of one `depth` or `query` computation: visibility bits and a_i in
+/// storage buffers, read back only on request (wrapped by the public [`GpuVisibility`]).
 pub(crate) struct DepthRun {
     bits: wgpu::Buffer,
     ambient: wgpu::Buffer,
@@ -476,6 +557,26 @@ pub(crate) struct DepthRun {
 }
 
 impl DepthRun {
+    /// The visibility bits, row-major, `words_per_row` u32 words per receiver.
+    pub(crate) fn bits_buffer(&self) -> &wgpu::Buffer {
+        &self.bits
+    }
+
+    /// a_i, one f32 per receiver (0 for zero-normal vertices on the GPU).
+    pub(crate) fn ambient_buffer(&self) -> &wgpu::Buffer {
+        &self.ambient
+    }
+
+    /// Receiver rows N.
+    pub(crate) fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// u32 words per row, ⌈k/32⌉.
+    pub(crate) fn words_per_row(&self) -> usize {
+        self.words_per_row
+    }
+
     /// Reads a_i back (N floats); NaN for vertices with a zero normal.
     pub(crate) fn read_ambient(
         &self,
