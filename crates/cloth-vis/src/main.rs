@@ -45,28 +45,55 @@ enum Command {
         /// Lightsphere level s (k = 2 + 4^(s+1) directions).
         #[arg(long, default_value_t = 3)]
         level: u32,
-        /// Backend: depth (GPU depth maps) or cpu (exact ray casting); default depth on a
-        /// hardware GPU, cpu otherwise.
-        #[arg(long, value_parser = ["depth", "cpu"])]
+        /// Backend: depth (GPU depth maps), query (the published per-vertex occlusion
+        /// queries; slow, N·k draws) or cpu (exact ray casting); default depth on a hardware
+        /// GPU, cpu otherwise.
+        #[arg(long, value_parser = ["depth", "query", "cpu"])]
         backend: Option<String>,
-        /// Depth-map side for the depth backend.
+        /// Depth-map side for the depth and query backends.
         #[arg(long, default_value_t = occlusion_gpu::DEFAULT_DEPTH_RESOLUTION)]
         depth_res: u32,
-        /// HDR environment (.hdr/.exr) for the colours of a .ply output.
+        /// HDR environment (.hdr/.exr) for the colours of a .ply/.glb output and --render
+        /// (without --env or --sky: the grey ambient term a_i).
         #[arg(long, conflicts_with = "sky")]
         env: Option<PathBuf>,
-        /// Use the procedural sky for the colours of a .ply output.
+        /// Use the procedural sky as the environment (see --env).
         #[arg(long)]
         sky: bool,
-        /// Output: .npy (a_i as f32 [N] or [F, N]; M as [N, k] with --matrix) or .ply.
+        /// Rotate the environment by DEG degrees about +Y relative to the object (rotated
+        /// look-ups of I_j; M is not recomputed). Needs --env or --sky.
+        #[arg(
+            long,
+            value_name = "DEG",
+            default_value_t = 0.0,
+            allow_negative_numbers = true
+        )]
+        env_rotation: f32,
+        /// Output: .npy (a_i as f32 [N] or [F, N]; M as [N, k] or [F, N, k] with --matrix),
+        /// .ply (one frame: colour, float `ao` = a_i, NaN for unused vertices) or .glb (one
+        /// frame: linear float COLOR_0, float `_AO` = a_i, -1 for unused vertices).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// Write the matrix M instead of a_i.
+        /// Write the matrix M instead of a_i (.npy only).
         #[arg(long)]
         matrix: bool,
         /// Frames A..B of an animation (end exclusive).
         #[arg(long, value_parser = parse_range)]
         frames: Option<(usize, usize)>,
+        /// Render the last frame with its vertex radiance: FILE.png (tone-mapped) or FILE.exr
+        /// (linear HDR). Needs a GPU adapter (lavapipe is fine).
+        #[arg(long, value_name = "FILE")]
+        render: Option<PathBuf>,
+        /// PNG exposure in stops (multiplier 2^EV); default: auto (the 90th percentile of the
+        /// vertex luminance maps to 0.8).
+        #[arg(long, value_name = "EV", allow_negative_numbers = true)]
+        exposure: Option<f32>,
+        /// PNG display gamma.
+        #[arg(long, value_name = "G", default_value_t = cloth_vis::visibility_cmd::DEFAULT_GAMMA)]
+        gamma: f32,
+        /// Rendered image size.
+        #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "768x768")]
+        render_size: [u32; 2],
     },
     /// Load a mesh or an animation and print what the loader found (counts, quirks, time).
     Inspect {
@@ -124,9 +151,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             depth_res,
             env,
             sky,
+            env_rotation,
             out,
             matrix,
             frames,
+            render,
+            exposure,
+            gamma,
+            render_size,
         } => {
             let environment = match (env, sky) {
                 (Some(path), _) => Some(lightsphere::Environment::load(&path)?),
@@ -138,15 +170,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 }
                 (None, false) => None,
             };
-            let backend = backend.map(|b| {
-                if b == "cpu" {
-                    occlusion_gpu::Backend::Cpu
-                } else {
-                    occlusion_gpu::Backend::Depth
-                }
+            let backend = backend.map(|b| match b.as_str() {
+                "cpu" => occlusion_gpu::Backend::Cpu,
+                "query" => occlusion_gpu::Backend::Query,
+                _ => occlusion_gpu::Backend::Depth,
             });
             let gpu = match backend {
-                Some(occlusion_gpu::Backend::Cpu) => None,
+                Some(occlusion_gpu::Backend::Cpu) if render.is_none() => None,
+                // --render without an adapter is refused by run_visibility, naming the flag.
+                Some(occlusion_gpu::Backend::Cpu) => {
+                    gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()).ok()
+                }
                 Some(_) => Some(gpu_context::GpuContext::new(
                     &gpu_context::GpuOptions::default(),
                 )?),
@@ -158,9 +192,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 backend,
                 depth_resolution: depth_res,
                 environment,
+                env_rotation_deg: env_rotation,
                 out,
                 matrix,
                 frames,
+                render,
+                exposure_ev: exposure,
+                gamma,
+                render_size,
             };
             let summary = cloth_vis::visibility_cmd::run_visibility(&request, gpu.as_ref())?;
             writeln!(std::io::stdout().lock(), "{}", summary.line())?;
@@ -183,6 +222,19 @@ fn parse_range(text: &str) -> Result<(usize, usize), String> {
         .parse::<usize>()
         .map_err(|e| format!("{b:?}: {e}"))?;
     Ok((a, b))
+}
+
+/// Parse `WxH` (e.g. `640x480`).
+fn parse_size(text: &str) -> Result<[u32; 2], String> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{text:?} is not WxH (e.g. 640x480)"))?;
+    let side = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .map_err(|e| format!("{s:?} in {text:?}: {e}"))
+    };
+    Ok([side(w)?, side(h)?])
 }
 
 fn inspect(input: &Path, animation: bool) -> anyhow::Result<()> {

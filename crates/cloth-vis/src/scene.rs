@@ -192,6 +192,8 @@ pub enum VisibilityBackendDesc {
     Cpu,
     /// GPU depth maps and a compute-pass depth test.
     Depth,
+    /// The published per-vertex hardware occlusion queries (paper 000 §3.2; slow: N·k draws).
+    Query,
 }
 
 /// Visibility parameters.

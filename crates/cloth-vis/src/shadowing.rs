@@ -55,6 +55,7 @@ pub fn visibility(
     let backend = match scene.visibility.backend {
         VisibilityBackendDesc::Cpu => Backend::Cpu,
         VisibilityBackendDesc::Depth => Backend::Depth,
+        VisibilityBackendDesc::Query => Backend::Query,
         VisibilityBackendDesc::Auto if gpu.summary().is_software => Backend::Cpu,
         VisibilityBackendDesc::Auto => Backend::Depth,
     };

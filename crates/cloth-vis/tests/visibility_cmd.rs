@@ -34,14 +34,11 @@ fn grid_obj(dir: &std::path::Path) -> std::path::PathBuf {
 
 fn request(input: std::path::PathBuf, out: Option<std::path::PathBuf>) -> VisibilityRequest {
     VisibilityRequest {
-        input,
         level: 2,
         backend: Some(occlusion_gpu::Backend::Cpu),
         depth_resolution: 256,
-        environment: None,
         out,
-        matrix: false,
-        frames: None,
+        ..VisibilityRequest::new(input)
     }
 }
 
@@ -99,13 +96,13 @@ fn ply_output_reads_back_with_the_same_counts() {
 fn bad_requests_are_refused_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let input = grid_obj(dir.path());
-    let glb = dir.path().join("out.glb");
-    let err = run_visibility(&request(input.clone(), Some(glb.clone())), None).unwrap_err();
+    let txt = dir.path().join("out.txt");
+    let err = run_visibility(&request(input.clone(), Some(txt.clone())), None).unwrap_err();
     assert!(
-        matches!(err, Error::Request { .. }) && err.to_string().contains("out.glb"),
+        matches!(err, Error::Request { .. }) && err.to_string().contains("out.txt"),
         "{err}"
     );
-    assert!(!glb.exists());
+    assert!(!txt.exists());
     let mut frames = request(input.clone(), None);
     frames.frames = Some((0, 2));
     let err = run_visibility(&frames, None).unwrap_err().to_string();
