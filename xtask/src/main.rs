@@ -3,12 +3,17 @@
 //! - `cargo xtask repro lightsphere`: what each lightsphere level and I_j method costs in time
 //!   and buys in accuracy, on every HDR map in `../shared/data/env` and the procedural sky
 //!   (`target/repro/lightsphere.md` and `lightsphere.svg`).
+//! - `cargo xtask repro visibility [--quick] [--max-level 4]`: the visibility engine's `cpu`,
+//!   `depth` and `query` backends on the full bunny and the synthetic cloth — time, rays/s,
+//!   |Δa| against `cpu` and against a level-6 reference — beside the seed's Table 1
+//!   (`target/repro/visibility.md` and `visibility.svg`).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 
 mod compare_clustering;
 mod plot;
 mod repro_lightsphere;
+mod repro_visibility;
 
 use std::path::PathBuf;
 
@@ -53,6 +58,16 @@ enum Repro {
         #[arg(long, default_value_t = 6)]
         max_level: u32,
     },
+    /// Visibility backends (cpu, depth, query) × levels × depth resolutions: time, rays/s,
+    /// ambient error against cpu and against a level-6 cpu reference (paper 000, Table 1).
+    Visibility {
+        /// Levels 0–3, resolutions 256 and 1024, level-5 reference, smaller query budget.
+        #[arg(long)]
+        quick: bool,
+        /// Highest level to evaluate (at most 3 with --quick).
+        #[arg(long, default_value_t = 4)]
+        max_level: u32,
+    },
 }
 
 /// `target/repro` of the workspace.
@@ -67,6 +82,9 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Lightsphere { max_level },
         } => repro_lightsphere::run(&repro_dir()?, max_level),
+        Command::Repro {
+            what: Repro::Visibility { quick, max_level },
+        } => repro_visibility::run(&repro_dir()?, quick, max_level),
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {

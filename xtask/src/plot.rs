@@ -11,8 +11,9 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-const PALETTE: [&str; 8] = [
+const PALETTE: [&str; 12] = [
     "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2",
+    "#bcbd22", "#7f7f7f", "#393b79", "#ad494a",
 ];
 
 /// Render `series` as an SVG chart with log10 axes.
