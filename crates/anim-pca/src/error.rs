@@ -1,0 +1,110 @@
+//! The crate's error type.
+
+use clustering::ClusteringError;
+
+/// Everything that can go wrong in `anim-pca`.
+///
+/// Each variant names the call (`what`), the element and the value, and its message says how
+/// to fix the input.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum AnimPcaError {
+    /// The clip has no frames or its frames have no vertices.
+    #[error(
+        "{what}: the clip has {frames} frame(s) of {vertices} vertices; pass at least one \
+         frame with at least one vertex"
+    )]
+    EmptyClip {
+        /// The call that received the clip.
+        what: &'static str,
+        /// Frames given.
+        frames: usize,
+        /// Vertices in frame 0 (0 when there is no frame).
+        vertices: usize,
+    },
+    /// The clip has too few frames for the operation.
+    #[error(
+        "{what}: the clip has {frames} frame(s) but at least {min} are needed; pass a longer clip"
+    )]
+    TooFewFrames {
+        /// The call that received the clip.
+        what: &'static str,
+        /// Frames given.
+        frames: usize,
+        /// Frames needed.
+        min: usize,
+    },
+    /// A frame has a different vertex count than frame 0.
+    #[error(
+        "{what}: frame {frame} has {found} vertices but frame 0 has {expected}; every frame of \
+         a clip must have the same vertices (constant connectivity, thesis §3.2.2)"
+    )]
+    VertexCountMismatch {
+        /// The call that received the clip.
+        what: &'static str,
+        /// Index of the offending frame.
+        frame: usize,
+        /// Vertex count of frame 0.
+        expected: usize,
+        /// Vertex count of the offending frame.
+        found: usize,
+    },
+    /// A coordinate is NaN or infinite.
+    #[error(
+        "{what}: frame {frame}, vertex {vertex} has the non-finite coordinate {value}; remove \
+         or repair the frame"
+    )]
+    NonFinite {
+        /// The call that received the clip.
+        what: &'static str,
+        /// Frame index.
+        frame: usize,
+        /// Vertex index.
+        vertex: usize,
+        /// The offending value.
+        value: f32,
+    },
+    /// A parameter is out of range.
+    #[error("{what}: parameter `{name}` = {value} is invalid: {reason}")]
+    InvalidParameter {
+        /// The call that received the parameter.
+        what: &'static str,
+        /// Field name, e.g. `"sigma"`.
+        name: &'static str,
+        /// The value given, printed.
+        value: String,
+        /// What range is valid.
+        reason: &'static str,
+    },
+    /// A slice has the wrong length.
+    #[error("{what}: expected {expected} elements but got {found}")]
+    LengthMismatch {
+        /// The call and argument, e.g. `"Reconstructor::reconstruct weights"`.
+        what: &'static str,
+        /// Length needed.
+        expected: usize,
+        /// Length given.
+        found: usize,
+    },
+    /// The PCA failed (see the inner error).
+    #[error("PCA of the clip failed: {0}")]
+    Pca(#[from] ClusteringError),
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = AnimPcaError> = std::result::Result<T, E>;
+
+/// An [`AnimPcaError::InvalidParameter`].
+pub(crate) fn invalid(
+    what: &'static str,
+    name: &'static str,
+    value: impl std::fmt::Display,
+    reason: &'static str,
+) -> AnimPcaError {
+    AnimPcaError::InvalidParameter {
+        what,
+        name,
+        value: value.to_string(),
+        reason,
+    }
+}

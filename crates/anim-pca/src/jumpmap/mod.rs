@@ -1,0 +1,39 @@
+//! Jump maps: new, endless animation from a short mesh clip (thesis §3.2, eqs. 3.1–3.13).
+//!
+//! Video textures (Schödl et al. 2000) carried over to geometry and computed on PCA weights
+//! (Sattler et al. 2004):
+//!
+//! 1. [`JumpMap::analyze`] (§3.2.2): PCA of the frame vectors A_i with c components (eq. 3.1),
+//!    PCA of the central velocities with c* components (eq. 3.4), L1 distance matrices D, D*
+//!    on the weights (eqs. 3.2, 3.5), transition probabilities P, P* (eqs. 3.3, 3.6) and the
+//!    jump map P̂ (eq. 3.8), then a dead-end pruning pass ([`graph`]).
+//! 2. [`Player`]: endless random play with a memory of m < 5 frames, blended (eq. 3.9–3.10)
+//!    or variable-length (eq. 3.11) transitions, deterministic for a seed.
+//! 3. [`Reconstructor`]: frames from weights (eq. 3.1), f32, allocation-free.
+//! 4. [`metrics`]: E(c), E*(c) (eqs. 3.12–3.13) and measures of a generated sequence.
+//!
+//! # Deviations from the thesis, and why
+//! * **Distance unit.** D and D* are divided by their mean off-diagonal entry, so σ, σ* are
+//!   fractions of a typical frame distance and the thesis's σ ≈ 0.05 (avatar) and 0.30
+//!   (skeleton) mean the same on every clip, whatever its size, units or c.
+//! * **Last frame** (no successor for eq. 3.3's D_{i+1,j}): its row uses the target's
+//!   predecessor, P_{l−1,j} ∝ exp(−D_{l−1,j−1}/σ), j ∈ 1 … l−2; see [`probability`].
+//! * **End velocities** (eq. 3.4 sets v_0 = v_l = 0): an end that repeats another frame (a
+//!   cycle with a closing frame, within [`CLOSING_MATCH`]·d̄) takes that frame's neighbour
+//!   into its central difference; other ends use one-sided differences. Zero end velocities
+//!   would make the ends look like rest poses and forbid the very jumps a loop needs.
+//! * **Eq. 3.10** is replaced by a linear cross-fade between two advancing streams; eq. 3.11
+//!   measures the jump residual ‖Ã_{i+1} − Ã_j‖; see [`player`].
+//! * **P̂** is row-normalised after eq. 3.8 so that it can be sampled.
+
+pub mod graph;
+pub mod metrics;
+pub mod player;
+pub mod probability;
+
+mod analysis;
+mod reconstruct;
+
+pub use analysis::{CLOSING_MATCH, JumpMap, JumpMapParams};
+pub use player::{Blend, Generated, GeneratedFrame, PlaybackParams, Player, Transition};
+pub use reconstruct::Reconstructor;
