@@ -150,15 +150,7 @@ struct CpuTracer {
 impl CpuTracer {
     /// Builds the BVH over all scene triangles (degenerate ones included: they never hit).
     fn new(prepared: &Prepared) -> Self {
-        let tris: Vec<Triangle> = prepared
-            .triangles
-            .iter()
-            .map(|t| Triangle {
-                v0: prepared.positions[t[0] as usize].into(),
-                v1: prepared.positions[t[1] as usize].into(),
-                v2: prepared.positions[t[2] as usize].into(),
-            })
-            .collect();
+        let tris = scene_triangles(prepared);
         if tris.is_empty() {
             return Self {
                 bvh: CwBvh::default(),
@@ -294,15 +286,7 @@ struct PacketTracer {
 
 impl PacketTracer {
     fn new(prepared: &Prepared) -> Self {
-        let tris: Vec<Triangle> = prepared
-            .triangles
-            .iter()
-            .map(|t| Triangle {
-                v0: prepared.positions[t[0] as usize].into(),
-                v1: prepared.positions[t[1] as usize].into(),
-                v2: prepared.positions[t[2] as usize].into(),
-            })
-            .collect();
+        let tris = scene_triangles(prepared);
         if tris.is_empty() {
             return Self {
                 nodes: Vec::new(),
@@ -467,18 +451,7 @@ fn packet_columns(
             (out, rays)
         })
         .collect();
-    let mut rays = 0;
-    for (rows, (out, chunk_rays)) in order.chunks(PACKET).zip(chunks) {
-        rays += chunk_rays;
-        for (&row, out_row) in rows.iter().zip(out.chunks_exact(words_per_row)) {
-            let target = &mut bits[row as usize * words_per_row..][..words_per_row];
-            for j in columns.clone() {
-                let (w, mask) = (j / WORD_BITS, 1u32 << (j % WORD_BITS));
-                target[w] = (target[w] & !mask) | (out_row[w] & mask);
-            }
-        }
-    }
-    rays
+    scatter_chunks(&order, PACKET, chunks, columns, bits, words_per_row)
 }
 
 /// Rows per work item of the BVH method: neighbours in Morton order share a shadow cache
@@ -531,8 +504,22 @@ fn bvh_columns(
             (out, rays)
         })
         .collect();
+    scatter_chunks(&order, ROWS_PER_CHUNK, chunks, columns, bits, words_per_row)
+}
+
+/// Copies the columns `columns` of per-chunk row blocks (rows `order` in chunks of
+/// `chunk_rows`, as computed in Morton order) into the row-major `bits`; returns the rays
+/// the chunks cast.
+fn scatter_chunks(
+    order: &[u32],
+    chunk_rows: usize,
+    chunks: Vec<(Vec<u32>, u64)>,
+    columns: Range<usize>,
+    bits: &mut [u32],
+    words_per_row: usize,
+) -> u64 {
     let mut rays = 0;
-    for (rows, (out, chunk_rays)) in order.chunks(ROWS_PER_CHUNK).zip(chunks) {
+    for (rows, (out, chunk_rays)) in order.chunks(chunk_rows).zip(chunks) {
         rays += chunk_rays;
         for (&row, out_row) in rows.iter().zip(out.chunks_exact(words_per_row)) {
             let target = &mut bits[row as usize * words_per_row..][..words_per_row];
@@ -543,6 +530,19 @@ fn bvh_columns(
         }
     }
     rays
+}
+
+/// The scene's triangles as `obvhs` takes them (degenerate ones included: they never hit).
+fn scene_triangles(prepared: &Prepared) -> Vec<Triangle> {
+    prepared
+        .triangles
+        .iter()
+        .map(|t| Triangle {
+            v0: prepared.positions[t[0] as usize].into(),
+            v1: prepared.positions[t[1] as usize].into(),
+            v2: prepared.positions[t[2] as usize].into(),
+        })
+        .collect()
 }
 
 /// The receiver rows sorted by the Morton code of their positions (10 bits per axis over the
