@@ -33,6 +33,7 @@
 //! # Ok::<(), cloth_vis::Error>(())
 //! ```
 
+pub mod anim_cmd;
 pub mod camera;
 pub mod demo;
 pub mod effects;

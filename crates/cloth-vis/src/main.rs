@@ -38,6 +38,11 @@ enum Command {
         #[arg(long)]
         quiet: bool,
     },
+    /// Animation from mesh clips by PCA (thesis §3).
+    Anim {
+        #[command(subcommand)]
+        command: AnimCommand,
+    },
     /// Visibility matrix M and ambient term a_i of a mesh or an animation (paper 000).
     Visibility {
         /// A mesh (.ply .obj .gltf .glb) or an animation (folder of numbered .obj, .npy, .glb).
@@ -124,6 +129,55 @@ fn main() -> ExitCode {
     }
 }
 
+#[derive(Subcommand)]
+enum AnimCommand {
+    /// Endless new animation from a short clip by jump maps (thesis §3.2): writes N frames as
+    /// .npy [N, V, 3], a .glb morph-target animation, or a folder of OBJ frames.
+    Jumpmap {
+        /// The clip: a folder of numbered .obj frames, .npy [F, V, 3] or an animated .glb.
+        input: PathBuf,
+        /// c: PCA components of the frames.
+        #[arg(long, default_value_t = 10)]
+        components: usize,
+        /// c*: PCA components of the central velocities.
+        #[arg(long, default_value_t = 5)]
+        velocity_components: usize,
+        /// σ (eq. 3.3), in units of the clip's mean frame-to-frame-pair distance.
+        #[arg(long, default_value_t = 0.05)]
+        sigma: f64,
+        /// σ* (eq. 3.6), in the same units for velocities.
+        #[arg(long, default_value_t = 0.05)]
+        sigma_v: f64,
+        /// q (eq. 3.8): base probability of the position term, 0..1.
+        #[arg(long, default_value_t = 0.0)]
+        q: f64,
+        /// q* (eq. 3.8): base probability of the velocity term, 0..1.
+        #[arg(long, default_value_t = 0.0)]
+        qv: f64,
+        /// m: recently visited frames forbidden as jump targets (< 5).
+        #[arg(long, default_value_t = 2)]
+        memory: usize,
+        /// b: blend frames per transition (0 = cut; default 3).
+        #[arg(long, conflicts_with = "smoothness")]
+        blend: Option<usize>,
+        /// s: variable-length blends from a smoothness (eq. 3.11), in mean frame steps.
+        #[arg(long)]
+        smoothness: Option<f64>,
+        /// Frames to generate.
+        #[arg(long, default_value_t = 300)]
+        frames: usize,
+        /// Seed of the jumps (same seed, same animation).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output: FILE.npy, FILE.glb or a folder name (OBJ frames).
+        #[arg(long)]
+        out: PathBuf,
+        /// Folder for the heat maps of D, D*, P, P*, P̂ (PNG).
+        #[arg(long)]
+        maps: Option<PathBuf>,
+    },
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Render { scene, out, quiet } => {
@@ -144,6 +198,49 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             write!(std::io::stdout().lock(), "{}", output.report.table())?;
         }
         Command::Inspect { input, animation } => inspect(&input, animation)?,
+        Command::Anim {
+            command:
+                AnimCommand::Jumpmap {
+                    input,
+                    components,
+                    velocity_components,
+                    sigma,
+                    sigma_v,
+                    q,
+                    qv,
+                    memory,
+                    blend,
+                    smoothness,
+                    frames,
+                    seed,
+                    out,
+                    maps,
+                },
+        } => {
+            let request = cloth_vis::anim_cmd::JumpMapRequest {
+                input,
+                params: anim_pca::JumpMapParams {
+                    components,
+                    velocity_components,
+                    sigma,
+                    sigma_velocity: sigma_v,
+                    q,
+                    q_velocity: qv,
+                    ..Default::default()
+                },
+                playback: anim_pca::PlaybackParams {
+                    memory,
+                    blend: cloth_vis::anim_cmd::blend_from_flags(blend, smoothness),
+                    seed,
+                    ..Default::default()
+                },
+                frames,
+                out,
+                maps,
+            };
+            let summary = cloth_vis::anim_cmd::run_jumpmap(&request)?;
+            writeln!(std::io::stdout().lock(), "{}", summary.line())?;
+        }
         Command::Visibility {
             input,
             level,

@@ -1,0 +1,277 @@
+//! `cloth-vis anim jumpmap`: endless new animation from a short mesh clip by jump maps
+//! (thesis §3.2, crate `anim-pca`), written as `.npy` [N, V, 3], a `.glb` morph-target
+//! animation or a folder of numbered OBJ frames, with the analysis matrices D, D*, P, P*, P̂
+//! as PNG heat maps (the thesis's Fig. 3.3).
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use anim_pca::{Blend, JumpMap, JumpMapParams, PlaybackParams, Player};
+use glam::Vec3;
+
+use crate::Error;
+
+/// What `cloth-vis anim jumpmap` was asked to do.
+#[derive(Clone, Debug)]
+pub struct JumpMapRequest {
+    /// The clip: a folder of numbered OBJ frames, `.npy` [F, V, 3] or an animated glTF.
+    pub input: PathBuf,
+    /// Analysis parameters (c, c*, σ, σ*, q, q*).
+    pub params: JumpMapParams,
+    /// Playback parameters (memory m, blending, seed).
+    pub playback: PlaybackParams,
+    /// Frames to generate.
+    pub frames: usize,
+    /// `.npy`, `.glb`, or a folder (no extension) of `frame_00000.obj` …
+    pub out: PathBuf,
+    /// Folder for the heat maps `D.png`, `D_velocity.png`, `P.png`, `P_velocity.png`,
+    /// `P_hat.png` (`None`: none written).
+    pub maps: Option<PathBuf>,
+}
+
+/// What was generated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JumpMapSummary {
+    /// Clip frames and vertices.
+    pub clip_frames: usize,
+    /// Vertices per frame.
+    pub vertices: usize,
+    /// PCA components used (c, c*).
+    pub components: (usize, usize),
+    /// Statistics of the generated run.
+    pub stats: anim_pca::jumpmap::metrics::SequenceStats,
+}
+
+impl JumpMapSummary {
+    /// One line for the terminal.
+    pub fn line(&self) -> String {
+        let s = &self.stats;
+        format!(
+            "jumpmap: {} frames from a {}-frame clip of {} vertices (c = {}, c* = {}): {} transitions, \
+             {} distinct, {:.0}% of the clip visited, jump residual mean {:.2} / max {:.2} d̄",
+            s.frames,
+            self.clip_frames,
+            self.vertices,
+            self.components.0,
+            self.components.1,
+            s.transitions,
+            s.distinct_transitions,
+            100.0 * s.coverage,
+            s.mean_jump_distance,
+            s.max_jump_distance
+        )
+    }
+}
+
+fn invalid(path: &Path, message: String) -> Error {
+    Error::Request {
+        path: path.to_owned(),
+        message,
+    }
+}
+
+fn anim_error(path: &Path, e: anim_pca::AnimPcaError) -> Error {
+    invalid(path, e.to_string())
+}
+
+/// The kind of output `out` names.
+enum OutKind {
+    Npy,
+    Glb,
+    ObjFolder,
+}
+
+/// Runs the request.
+///
+/// # Errors
+/// Loader errors naming the file; bad parameters (naming the parameter and value), an
+/// unsupported output extension or a zero frame count, refused before any computation; write
+/// errors naming the file.
+pub fn run_jumpmap(request: &JumpMapRequest) -> Result<JumpMapSummary, Error> {
+    let out = &request.out;
+    let kind = match out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("npy") => OutKind::Npy,
+        Some("glb") => OutKind::Glb,
+        None => OutKind::ObjFolder,
+        Some(other) => {
+            return Err(invalid(
+                out,
+                format!(
+                    "output extension .{other} is not supported: use .npy ([N, V, 3]), .glb \
+                     (morph-target animation) or a folder name without extension (OBJ frames)"
+                ),
+            ));
+        }
+    };
+    if request.frames == 0 {
+        return Err(invalid(out, "--frames must be at least 1".to_owned()));
+    }
+    let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
+    let map = JumpMap::analyze(&clip.frames, &request.params)
+        .map_err(|e| anim_error(&request.input, e))?;
+    let mut player =
+        Player::new(&map, &request.playback).map_err(|e| anim_error(&request.input, e))?;
+    let generated = player.generate(request.frames);
+    let stats = anim_pca::jumpmap::metrics::sequence_stats(&map, &generated);
+
+    let vertices = map.n_vertices();
+    let mut weights = vec![0.0; map.components()];
+    let mut frames = Vec::with_capacity(request.frames);
+    for frame in &generated.frames {
+        frame.weights_into(&map, &mut weights);
+        let mut mesh = vec![Vec3::ZERO; vertices];
+        map.reconstructor()
+            .reconstruct(&weights, &mut mesh)
+            .map_err(|e| anim_error(&request.input, e))?;
+        frames.push(mesh);
+    }
+    match kind {
+        OutKind::Npy => {
+            let data: Vec<f32> = frames
+                .iter()
+                .flat_map(|f| f.iter().flat_map(|v| v.to_array()))
+                .collect();
+            meshio::write_npy_f32(out, &[frames.len(), vertices, 3], &data)?;
+        }
+        OutKind::Glb => {
+            if clip.triangles.is_empty() {
+                return Err(invalid(
+                    &request.input,
+                    "the clip has no triangles (an .npy clip): write .npy instead of .glb"
+                        .to_owned(),
+                ));
+            }
+            let animation = meshio::Animation {
+                triangles: clip.triangles.clone(),
+                frames,
+                frame_rate: clip.frame_rate,
+                uvs: clip.uvs.clone(),
+            };
+            meshio::write_glb_animation(out, &animation)?;
+        }
+        OutKind::ObjFolder => write_obj_frames(out, &frames, &clip.triangles)?,
+    }
+    if let Some(dir) = &request.maps {
+        write_maps(dir, &map)?;
+    }
+    Ok(JumpMapSummary {
+        clip_frames: map.n_frames(),
+        vertices,
+        components: (map.components(), map.velocity_components()),
+        stats,
+    })
+}
+
+/// Numbered OBJ frames `frame_00000.obj` … in `dir` (created), each written atomically.
+fn write_obj_frames(dir: &Path, frames: &[Vec<Vec3>], triangles: &[[u32; 3]]) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
+        path: dir.to_owned(),
+        reason: e.to_string(),
+    })?;
+    for (f, positions) in frames.iter().enumerate() {
+        let path = dir.join(format!("frame_{f:05}.obj"));
+        meshio::write_atomic(&path, |w| {
+            writeln!(w, "# cloth-vis anim jumpmap, generated frame {f}")?;
+            for p in positions {
+                writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+            }
+            for t in triangles {
+                writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+            }
+            Ok(())
+        })?;
+    }
+    Ok(())
+}
+
+/// The five matrices of the analysis as heat maps, one pixel per entry (scaled up to at least
+/// 256 pixels a side): distances linearly from 0 to their maximum, probabilities on a log
+/// scale over six decades below the matrix's maximum (as the thesis's Fig. 3.3 shows them,
+/// black = 0).
+fn write_maps(dir: &Path, map: &JumpMap) -> Result<(), Error> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
+        path: dir.to_owned(),
+        reason: e.to_string(),
+    })?;
+    let maps: [(&str, &anim_pca::SquareMatrix, bool); 5] = [
+        ("D.png", map.distances(), false),
+        ("D_velocity.png", map.velocity_distances(), false),
+        ("P.png", map.position_probabilities(), true),
+        ("P_velocity.png", map.velocity_probabilities(), true),
+        ("P_hat.png", map.jump_map(), true),
+    ];
+    for (name, matrix, log) in maps {
+        write_heat_map(&dir.join(name), matrix, log)?;
+    }
+    Ok(())
+}
+
+/// Decades below the maximum shown by a log-scale heat map.
+const LOG_DECADES: f64 = 6.0;
+
+/// Value in [0, 1] → a dark-blue … yellow ramp (a simple perceptual map, black at 0).
+fn ramp(t: f64) -> [u8; 3] {
+    let t = t.clamp(0.0, 1.0);
+    let stops = [
+        [0.0, 0.0, 0.0],
+        [0.15, 0.10, 0.45],
+        [0.75, 0.20, 0.45],
+        [0.98, 0.60, 0.15],
+        [1.0, 1.0, 0.6],
+    ];
+    let x = t * (stops.len() - 1) as f64;
+    let i = (x.floor() as usize).min(stops.len() - 2);
+    let f = x - i as f64;
+    let c = |k: usize| stops[i][k] * (1.0 - f) + stops[i + 1][k] * f;
+    [0, 1, 2].map(|k| (c(k) * 255.0 + 0.5) as u8)
+}
+
+fn write_heat_map(path: &Path, matrix: &anim_pca::SquareMatrix, log: bool) -> Result<(), Error> {
+    let n = matrix.n();
+    let max = matrix.max();
+    let scale = (256usize.div_ceil(n.max(1))).max(1);
+    let side = (n * scale) as u32;
+    let value = |i: usize, j: usize| {
+        let v = matrix.get(i, j);
+        if !(v.is_finite() && max.is_finite() && max > 0.0) {
+            return 0.0;
+        }
+        if log {
+            if v <= 0.0 {
+                0.0
+            } else {
+                1.0 + (v / max).log10() / LOG_DECADES
+            }
+        } else {
+            v / max
+        }
+    };
+    let image = image::RgbImage::from_fn(side, side, |x, y| {
+        image::Rgb(ramp(value(y as usize / scale, x as usize / scale)))
+    });
+    let mut png = Vec::new();
+    image
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| Error::Io {
+            path: path.to_owned(),
+            reason: e.to_string(),
+        })?;
+    meshio::write_atomic(path, |w| w.write_all(&png))?;
+    Ok(())
+}
+
+/// Playback blending from the CLI's `--blend B` / `--smoothness S` (at most one; neither:
+/// the thesis's b = 3).
+pub fn blend_from_flags(blend: Option<usize>, smoothness: Option<f64>) -> Blend {
+    match (blend, smoothness) {
+        (_, Some(s)) => Blend::Smoothness(s),
+        (Some(0), None) => Blend::None,
+        (Some(b), None) => Blend::Fixed(b),
+        (None, None) => Blend::Fixed(3),
+    }
+}
