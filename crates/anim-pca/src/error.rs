@@ -86,6 +86,17 @@ pub enum AnimPcaError {
         /// Length given.
         found: usize,
     },
+    /// The clips given as cells (thesis §3.2.2 "Motion Control") do not fit together, or a
+    /// cell index is out of range.
+    #[error("{what}: cell {cell}: {reason}")]
+    InvalidCell {
+        /// The call that received the cells.
+        what: &'static str,
+        /// Index of the offending cell.
+        cell: usize,
+        /// What is wrong and how to fix it.
+        reason: String,
+    },
     /// The PCA failed (see the inner error).
     #[error("PCA of the clip failed: {0}")]
     Pca(#[from] ClusteringError),

@@ -8,7 +8,9 @@
 //! resembles itself, with blended transitions; the frames are rebuilt from their weights.
 //!
 //! * [`JumpMap`] — analysis (§3.2.2): D, D*, P, P*, P̂ (eqs. 3.2–3.8) and dead-end pruning.
-//! * [`Player`] — endless seeded play with memory and blending (eqs. 3.9–3.11).
+//! * [`Player`] — endless seeded play with memory and blending (eqs. 3.9–3.11), and motion
+//!   control between cells ([`JumpMap::analyze_cells`], [`Player::set_target_cell`]).
+//! * [`LoopTable`] — the cheapest fixed-length loop of every length (Fig. 3.2).
 //! * [`Reconstructor`] — frames from weights (eq. 3.1).
 //! * [`jumpmap::metrics`] — E(c), E*(c) (eqs. 3.12–3.13) and quality of a generated run.
 //!
@@ -51,7 +53,7 @@ mod matrix;
 pub use error::{AnimPcaError, Result};
 pub use jumpmap::metrics::{ReconstructionError, SequenceStats};
 pub use jumpmap::{
-    Blend, Generated, GeneratedFrame, JumpMap, JumpMapParams, PlaybackParams, Player,
-    Reconstructor, Transition,
+    AttributeReconstructor, Blend, Clip, Generated, GeneratedFrame, JumpMap, JumpMapParams, Loop,
+    LoopTable, PlaybackParams, Player, Reconstructor, Transition,
 };
 pub use matrix::SquareMatrix;

@@ -3,7 +3,9 @@
 mod common;
 
 use anim_pca::jumpmap::metrics::{reconstruction_errors, sequence_stats};
-use anim_pca::{AnimPcaError, Blend, JumpMap, JumpMapParams, PlaybackParams, Player};
+use anim_pca::{
+    AnimPcaError, Blend, Clip, JumpMap, JumpMapParams, LoopTable, PlaybackParams, Player,
+};
 use common::wave_clip;
 use glam::Vec3;
 
@@ -23,6 +25,13 @@ fn plays_finitely(map: &JumpMap, n: usize) {
             f.weights_into(map, &mut w);
             map.reconstructor().reconstruct(&w, &mut mesh).unwrap();
             assert!(mesh.iter().all(|v| v.is_finite()));
+        }
+        for cell in 0..map.n_cells() {
+            let table = LoopTable::build(map, cell, 30, blend).unwrap();
+            for lp in table.iter() {
+                assert!(lp.cost.is_finite() && lp.cost >= 0.0);
+                assert!(lp.frames.iter().all(|f| map.cell_of(f.from) == cell));
+            }
         }
     }
     for m in [
@@ -231,4 +240,46 @@ fn bad_parameters_name_the_parameter() {
             ..
         })
     ));
+}
+
+#[test]
+fn loops_of_two_frame_and_static_clips() {
+    // Two frames: the only jump, 1 → 0, is back-and-forth jitter, which loops never use.
+    let two = wave_clip(4, 2, 12.0, 0.0);
+    let map = JumpMap::analyze(&two, &JumpMapParams::default()).unwrap();
+    let table = LoopTable::build(&map, 0, 10, Blend::Fixed(3)).unwrap();
+    assert_eq!(table.iter().count(), 0);
+    // Static: every frame equals every other, so loops of every length are free.
+    let still = vec![wave_clip(3, 1, 12.0, 0.0)[0].clone(); 6];
+    let map = JumpMap::analyze(&still, &JumpMapParams::default()).unwrap();
+    let table = LoopTable::build(&map, 0, 12, Blend::None).unwrap();
+    for len in 3..=12 {
+        assert_eq!(table.get(len).map(|l| l.cost), Some(0.0), "length {len}");
+    }
+}
+
+#[test]
+fn cells_of_two_frames_static_and_outlier() {
+    let wave = wave_clip(4, 30, 8.0, 0.0);
+    let two = wave_clip(4, 2, 5.0, 0.0);
+    let still = vec![wave[3].clone(); 5];
+    let params = JumpMapParams {
+        components: 50, // more than the 37 frames of all cells together
+        ..JumpMapParams::default()
+    };
+    let map = JumpMap::analyze_cells(
+        &[Clip::new(&wave), Clip::new(&two), Clip::new(&still)],
+        &params,
+    )
+    .unwrap();
+    assert_eq!(map.n_cells(), 3);
+    plays_finitely(&map, 2_000);
+    // Visit every cell from every cell; play always lands in the requested one.
+    let mut player = Player::new(&map, &PlaybackParams::default()).unwrap();
+    for target in [1, 2, 0, 2, 1, 0] {
+        player.set_target_cell(target).unwrap();
+        let run = player.generate(200);
+        assert_eq!(player.current_cell(), target);
+        assert_eq!(map.cell_of(run.frames.last().unwrap().from), target);
+    }
 }

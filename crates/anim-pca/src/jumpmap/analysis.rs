@@ -4,12 +4,12 @@ use clustering::{ComponentCount, Pca, PcaMethod, PcaParams};
 use faer::{Mat, MatRef};
 use glam::Vec3;
 
+use super::cells::Layout;
 use super::graph;
 use super::probability::{
-    is_candidate, jump_map, l1_distances, normalise_by_mean_off_diagonal, shifted_cost,
-    transition_probabilities,
+    jump_map, l1_distances, normalise_by_mean_off_diagonal, shifted_cost, transition_probabilities,
 };
-use super::reconstruct::Reconstructor;
+use super::reconstruct::{AttributeReconstructor, Reconstructor};
 use crate::error::{AnimPcaError, Result, invalid};
 use crate::matrix::SquareMatrix;
 
@@ -42,6 +42,8 @@ pub struct JumpMapParams {
     /// [`JumpMap::analyze_with_normals`]: the normals are scaled so that their total variance
     /// is `normal_weight²` times that of the positions (≥ 0, finite).
     pub normal_weight: f64,
+    /// Components of the separate attribute PCA (R_i, [`Clip::with_attributes`]); ≥ 1.
+    pub attribute_components: usize,
 }
 
 impl Default for JumpMapParams {
@@ -54,6 +56,7 @@ impl Default for JumpMapParams {
             q: 0.0,
             q_velocity: 0.0,
             normal_weight: 1.0,
+            attribute_components: 4,
         }
     }
 }
@@ -69,6 +72,14 @@ impl JumpMapParams {
                 "velocity_components",
                 0,
                 "c* must be ≥ 1; to ignore velocities set q_velocity = 1",
+            ));
+        }
+        if self.attribute_components == 0 {
+            return Err(invalid(
+                WHAT,
+                "attribute_components",
+                0,
+                "the attribute PCA needs ≥ 1 component",
             ));
         }
         for (name, s) in [
@@ -101,6 +112,62 @@ impl JumpMapParams {
     }
 }
 
+/// One clip handed to [`JumpMap::analyze_cells`]: vertex positions per frame, optionally
+/// normals (in A_i, eq. 3.1) and an attribute vector R_i per frame (thesis §3.2.2 "Adding
+/// vertex attributes").
+#[derive(Clone, Copy, Debug)]
+pub struct Clip<'a> {
+    /// `positions[i][n]`: vertex n of frame i.
+    pub positions: &'a [Vec<Vec3>],
+    /// Normals per frame and vertex, if any.
+    pub normals: Option<&'a [Vec<Vec3>]>,
+    /// R_i per frame (any length ≥ 1, the same for every frame), if any.
+    pub attributes: Option<&'a [Vec<f32>]>,
+}
+
+impl<'a> Clip<'a> {
+    /// A clip of positions only.
+    pub fn new(positions: &'a [Vec<Vec3>]) -> Self {
+        Self {
+            positions,
+            normals: None,
+            attributes: None,
+        }
+    }
+
+    /// With normals in A_i.
+    pub fn with_normals(self, normals: &'a [Vec<Vec3>]) -> Self {
+        Self {
+            normals: Some(normals),
+            ..self
+        }
+    }
+
+    /// With attribute vectors R_i.
+    pub fn with_attributes(self, attributes: &'a [Vec<f32>]) -> Self {
+        Self {
+            attributes: Some(attributes),
+            ..self
+        }
+    }
+}
+
+/// The attribute PCA and every frame's weights.
+#[derive(Clone, Debug)]
+struct Attributes {
+    weights: Vec<f64>,
+    reconstructor: AttributeReconstructor,
+}
+
+impl Attributes {
+    fn new(pca: &Pca, weights: Vec<f64>) -> Self {
+        Self {
+            weights,
+            reconstructor: AttributeReconstructor::from_pca(pca),
+        }
+    }
+}
+
 /// The analysed clip: PCA weights of every frame, the matrices D, D*, P, P*, P̂ and the pruned
 /// sampling matrix the [`Player`](super::Player) draws from.
 #[derive(Clone, Debug)]
@@ -108,10 +175,12 @@ pub struct JumpMap {
     params: JumpMapParams,
     n_frames: usize,
     n_vertices: usize,
+    layout: Layout,
     pca: Pca,
     velocity_pca: Pca,
     weights: Vec<f64>,
     velocity_weights: Vec<f64>,
+    attributes: Option<Attributes>,
     distance_unit: f64,
     velocity_distance_unit: f64,
     d: SquareMatrix,
@@ -129,7 +198,7 @@ impl JumpMap {
     /// Analyses a clip given as vertex positions per frame (`positions[i][n]` = p_in).
     ///
     /// A_i holds the positions only. See [`JumpMap::analyze_with_normals`] for eq. 3.1 with
-    /// normals.
+    /// normals and [`JumpMap::analyze_cells`] for attributes and several clips.
     ///
     /// # Errors
     /// [`AnimPcaError::EmptyClip`] (no frames or no vertices), [`AnimPcaError::TooFewFrames`]
@@ -153,13 +222,13 @@ impl JumpMap {
     /// assert!(matches!(map.best_jump(3), Some(12 | 20)));
     /// ```
     pub fn analyze(positions: &[Vec<Vec3>], params: &JumpMapParams) -> Result<Self> {
-        Self::analyze_impl(positions, None, params)
+        Self::analyze_cells(&[Clip::new(positions)], params)
     }
 
     /// Analyses a clip with per-vertex normals in A_i (thesis §3.2.2 "Besides the vertex
     /// positions, the vertex normals are also included in the vectors A_i"). The normals are
     /// scaled by [`JumpMapParams::normal_weight`] relative to the positions' spread, so that
-    /// neither swamps the PCA (the thesis's R_i concern). Velocities use positions only.
+    /// neither swamps the PCA. Velocities use positions only.
     ///
     /// # Errors
     /// As [`JumpMap::analyze`]; also [`AnimPcaError::TooFewFrames`] /
@@ -169,32 +238,71 @@ impl JumpMap {
         normals: &[Vec<Vec3>],
         params: &JumpMapParams,
     ) -> Result<Self> {
-        Self::analyze_impl(positions, Some(normals), params)
+        Self::analyze_cells(&[Clip::new(positions).with_normals(normals)], params)
     }
 
-    fn analyze_impl(
-        positions: &[Vec<Vec3>],
-        normals: Option<&[Vec<Vec3>]>,
-        params: &JumpMapParams,
-    ) -> Result<Self> {
+    /// Analyses one or several clips (the thesis's *cells*, §3.2.2 "Motion Control") with one
+    /// common PCA, so that frames of different clips are comparable and the player can cross
+    /// from cell to cell ([`Player::set_target_cell`](super::Player::set_target_cell)).
+    ///
+    /// Frames are numbered consecutively, clip after clip; natural play never runs from the
+    /// last frame of a clip into the next clip. Random play stays in its cell: each cell gets
+    /// its own dead-end-free core ([`graph`](super::graph)), and D, D*, P, P*, P̂ span all
+    /// frames so that cross-cell transitions can be looked up.
+    ///
+    /// Attributes R_i ([`Clip::with_attributes`], thesis §3.2.2 "Adding vertex attributes")
+    /// get their own PCA with [`JumpMapParams::attribute_components`] components, so that
+    /// quantities of other units and scales (reflectance, wetness, per-vertex colour) neither
+    /// distort nor are distorted by the geometry's PCA. They follow the frames they belong
+    /// to but do not enter D: the jump structure is the motion's (eqs. 3.2, 3.5).
+    ///
+    /// # Errors
+    /// As [`JumpMap::analyze`] for every clip; [`AnimPcaError::InvalidCell`] when no clip is
+    /// given, or the clips disagree on vertex count, on having normals or attributes, or on
+    /// the attribute length.
+    ///
+    /// # Examples
+    /// ```
+    /// use anim_pca::{Clip, JumpMap, JumpMapParams};
+    /// use glam::Vec3;
+    /// // Two cells: a point circling left, and one circling right.
+    /// let circle = |x0: f32| -> Vec<Vec<Vec3>> {
+    ///     (0..24)
+    ///         .map(|t| {
+    ///             let a = t as f32 * std::f32::consts::TAU / 8.0;
+    ///             vec![Vec3::new(x0 + a.cos(), a.sin(), 0.0), Vec3::Z]
+    ///         })
+    ///         .collect()
+    /// };
+    /// let (left, right) = (circle(-1.0), circle(1.0));
+    /// let map = JumpMap::analyze_cells(
+    ///     &[Clip::new(&left), Clip::new(&right)],
+    ///     &JumpMapParams::default(),
+    /// )
+    /// .unwrap();
+    /// assert_eq!(map.n_cells(), 2);
+    /// assert_eq!(map.cell_range(1), 24..48);
+    /// ```
+    pub fn analyze_cells(clips: &[Clip<'_>], params: &JumpMapParams) -> Result<Self> {
         params.validate()?;
-        let n_vertices = validate_clip(WHAT, positions)?;
-        let l = positions.len();
-        if let Some(nrm) = normals {
-            if nrm.len() != l {
-                return Err(AnimPcaError::TooFewFrames {
-                    what: "JumpMap::analyze_with_normals normals",
-                    frames: nrm.len(),
-                    min: l,
-                });
-            }
-            validate_frames("JumpMap::analyze_with_normals normals", nrm, n_vertices)?;
-        }
+        let n_vertices = validate_clips(clips)?;
+        let layout = Layout::new(&clips.iter().map(|c| c.positions.len()).collect::<Vec<_>>());
+        let l = layout.n();
+        let positions: Vec<&[Vec3]> = clips
+            .iter()
+            .flat_map(|c| c.positions.iter().map(Vec::as_slice))
+            .collect();
+        let normals: Option<Vec<&[Vec3]>> = clips[0].normals.is_some().then(|| {
+            clips
+                .iter()
+                .flat_map(|c| c.normals.unwrap_or_default().iter().map(Vec::as_slice))
+                .collect()
+        });
 
         // A_i (eq. 3.1): positions, then scaled normals.
         let dp = 3 * n_vertices;
-        let normal_scale = normals.map(|n| {
-            let (vp, vn) = (total_variance(positions), total_variance(n));
+        let normal_scale = normals.as_ref().map(|n| {
+            let (vp, vn) = (total_variance(&positions), total_variance(n));
             if vp > 0.0 && vn > 0.0 {
                 params.normal_weight * (vp / vn).sqrt()
             } else {
@@ -205,7 +313,7 @@ impl JumpMap {
         let mut data = Vec::with_capacity(l * d);
         for i in 0..l {
             data.extend(positions[i].iter().flat_map(|v| v.to_array()));
-            if let (Some(n), Some(s)) = (normals, normal_scale) {
+            if let (Some(n), Some(s)) = (&normals, normal_scale) {
                 data.extend(n[i].iter().flat_map(|v| (*v * s as f32).to_array()));
             }
         }
@@ -214,33 +322,56 @@ impl JumpMap {
         let weights = flatten(&pca.project(a)?);
         drop(data);
 
-        // V_i (eq. 3.4) and its own PCA.
-        let (before_first, after_last) = closing_neighbours(&weights, l, pca.n_components());
-        let vel = velocities(positions, before_first, after_last);
+        // V_i (eq. 3.4) cell by cell, and their own PCA.
+        let mut vel = Vec::with_capacity(l * dp);
+        for r in layout.ranges() {
+            let c = pca.n_components();
+            let (before_first, after_last) =
+                closing_neighbours(&weights[r.start * c..r.end * c], r.len(), c);
+            vel.extend(velocities(&positions[r.clone()], before_first, after_last));
+        }
         let v = MatRef::from_row_major_slice(&vel, l, dp);
         let velocity_pca = fit(v, params.velocity_components)?;
         let velocity_weights = flatten(&velocity_pca.project(v)?);
         drop(vel);
+
+        // R_i: a PCA of its own.
+        let attributes = match clips[0].attributes {
+            None => None,
+            Some(first) => {
+                let m = first[0].len();
+                let flat: Vec<f32> = clips
+                    .iter()
+                    .flat_map(|c| c.attributes.unwrap_or_default().iter().flatten().copied())
+                    .collect();
+                let r = MatRef::from_row_major_slice(&flat, l, m);
+                let rpca = fit(r, params.attribute_components)?;
+                let rw = flatten(&rpca.project(r)?);
+                Some(Attributes::new(&rpca, rw))
+            }
+        };
 
         let (c, cv) = (pca.n_components(), velocity_pca.n_components());
         let mut dm = l1_distances(&weights, l, c); // eq. 3.2
         let distance_unit = normalise_by_mean_off_diagonal(&mut dm);
         let mut dvm = l1_distances(&velocity_weights, l, cv); // eq. 3.5
         let velocity_distance_unit = normalise_by_mean_off_diagonal(&mut dvm);
-        let p = transition_probabilities(&dm, params.sigma); // eq. 3.3
-        let pv = transition_probabilities(&dvm, params.sigma_velocity); // eq. 3.6
-        let p_hat = jump_map(&p, &pv, params.q, params.q_velocity); // eq. 3.8
-        let pruned = graph::prune(&p_hat);
+        let p = transition_probabilities(&layout, &dm, params.sigma); // eq. 3.3
+        let pv = transition_probabilities(&layout, &dvm, params.sigma_velocity); // eq. 3.6
+        let p_hat = jump_map(&layout, &p, &pv, params.q, params.q_velocity); // eq. 3.8
+        let pruned = graph::prune_cells(&p_hat, &layout);
 
         let reconstructor = Reconstructor::from_pca(&pca, n_vertices, normal_scale);
         let mut map = Self {
             params: *params,
             n_frames: l,
             n_vertices,
+            layout,
             pca,
             velocity_pca,
             weights,
             velocity_weights,
+            attributes,
             distance_unit,
             velocity_distance_unit,
             d: dm,
@@ -253,10 +384,10 @@ impl JumpMap {
             mean_step: 0.0,
             reconstructor,
         };
-        map.mean_step = (0..l - 1)
-            .map(|i| map.geometry_distance(i, i + 1))
-            .sum::<f64>()
-            / (l - 1) as f64;
+        let steps: Vec<f64> = (0..l)
+            .filter_map(|i| map.layout.successor(i).map(|s| map.geometry_distance(i, s)))
+            .collect();
+        map.mean_step = steps.iter().sum::<f64>() / steps.len().max(1) as f64;
         Ok(map)
     }
 
@@ -273,6 +404,56 @@ impl JumpMap {
     /// Number of vertices N per frame.
     pub fn n_vertices(&self) -> usize {
         self.n_vertices
+    }
+
+    /// Number of cells (clips given to [`JumpMap::analyze_cells`]; 1 for a single clip).
+    pub fn n_cells(&self) -> usize {
+        self.layout.ranges().len()
+    }
+
+    /// The frame range of cell `cell` in the consecutive numbering.
+    ///
+    /// # Panics
+    /// If `cell ≥ n_cells()`.
+    pub fn cell_range(&self, cell: usize) -> std::ops::Range<usize> {
+        self.layout.ranges()[cell].clone()
+    }
+
+    /// The cell frame i belongs to.
+    ///
+    /// # Panics
+    /// If `i ≥ n_frames()`.
+    pub fn cell_of(&self, i: usize) -> usize {
+        self.layout.cell_of(i)
+    }
+
+    /// The natural successor of frame i: i + 1 when it is in the same cell, `None` at the end
+    /// of a cell.
+    pub fn successor(&self, i: usize) -> Option<usize> {
+        self.layout.successor(i)
+    }
+
+    pub(crate) fn layout(&self) -> &Layout {
+        &self.layout
+    }
+
+    /// The reconstructor of attribute vectors R_i, if the map was analysed with attributes.
+    pub fn attribute_reconstructor(&self) -> Option<&AttributeReconstructor> {
+        self.attributes.as_ref().map(|a| &a.reconstructor)
+    }
+
+    /// Attribute weights of frame i (empty without attributes).
+    ///
+    /// # Panics
+    /// If `i ≥ n_frames()`.
+    pub fn attribute_weights(&self, i: usize) -> &[f64] {
+        match &self.attributes {
+            Some(a) => {
+                let c = a.reconstructor.components();
+                &a.weights[i * c..(i + 1) * c]
+            }
+            None => &[],
+        }
     }
 
     /// Components c actually kept (≤ requested: at most the clip's numerical rank, so 0 for a
@@ -362,14 +543,15 @@ impl JumpMap {
     }
 
     /// The most probable target of frame i in P̂ other than its natural successor i + 1 (and
-    /// other than i itself): the best "jump". `None` when frame i has no other candidate.
+    /// other than i itself), in any cell: the best "jump". `None` when frame i has no other
+    /// candidate.
     ///
     /// # Panics
     /// If `i ≥ n_frames()`.
     pub fn best_jump(&self, i: usize) -> Option<usize> {
         let row = self.p_hat.row(i);
         (0..self.n_frames)
-            .filter(|&j| j != i + 1 && j != i && is_candidate(self.n_frames, i, j))
+            .filter(|&j| j != i && self.layout.is_jump(i, j) && self.layout.is_candidate(i, j))
             .max_by(|&a, &b| row[a].total_cmp(&row[b]).then(b.cmp(&a)))
     }
 
@@ -384,35 +566,136 @@ impl JumpMap {
             .sqrt()
     }
 
-    /// d̄: the mean of ‖Ã_{i+1} − Ã_i‖₂ over the clip, the unit of the smoothness s (eq. 3.11).
+    /// d̄: the mean of ‖Ã_{i+1} − Ã_i‖₂ over the clip (over every cell's natural steps), the unit of the smoothness s (eq. 3.11).
     pub fn mean_frame_distance(&self) -> f64 {
         self.mean_step
     }
 
-    /// The discontinuity a jump i → j leaves: ‖Ã_{i+1} − Ã_j‖₂ (‖Ã_{l−1} − Ã_{j−1}‖₂ from the
-    /// last frame), the geometry counterpart of the shifted distance in eq. 3.3. 0 for the
-    /// natural successor.
+    /// The discontinuity a jump i → j leaves: ‖Ã_{i+1} − Ã_j‖₂ (‖Ã_i − Ã_{j−1}‖₂ from the
+    /// last frame of a cell), the geometry counterpart of the shifted distance in eq. 3.3. 0
+    /// for the natural successor.
     pub fn jump_residual(&self, i: usize, j: usize) -> f64 {
-        let l = self.n_frames;
-        if i + 1 < l {
-            self.geometry_distance(i + 1, j)
-        } else if j >= 1 {
-            self.geometry_distance(l - 1, j - 1)
+        if let Some(s) = self.layout.successor(i) {
+            self.geometry_distance(s, j)
+        } else if let Some(p) = self.layout.predecessor(j) {
+            self.geometry_distance(i, p)
         } else {
             0.0
         }
     }
 
     /// The normalised distance eq. 3.3 uses for the transition i → j (D_{i+1,j}, or
-    /// D_{l−1,j−1} from the last frame).
+    /// D_{i,j−1} from the last frame of a cell).
     pub fn shifted_distance(&self, i: usize, j: usize) -> f64 {
-        shifted_cost(&self.d, i, j)
+        shifted_cost(&self.layout, &self.d, i, j)
+    }
+
+    /// The normalised velocity distance eq. 3.6 uses for i → j (D*_{i+1,j}, as
+    /// [`JumpMap::shifted_distance`]).
+    pub fn shifted_velocity_distance(&self, i: usize, j: usize) -> f64 {
+        shifted_cost(&self.layout, &self.dv, i, j)
+    }
+
+    /// The *unnormalised* eq. 3.8 for i → j: [q + (1−q)·e^{−D_{i+1,j}/σ}]·[q* + (1−q*)·
+    /// e^{−D*_{i+1,j}/σ*}], i.e. P̂ before each row is divided by its sum. Unlike P̂ its values
+    /// compare across rows, which is what choosing *where* to leave a cell needs
+    /// ([`Player::set_target_cell`](super::Player::set_target_cell)). In (0, 1]; 1 for a
+    /// perfect match.
+    pub fn transition_score(&self, i: usize, j: usize) -> f64 {
+        let (q, qv) = (self.params.q, self.params.q_velocity);
+        let term = |d: f64, sigma: f64| (-(d / sigma)).exp();
+        (q + (1.0 - q) * term(self.shifted_distance(i, j), self.params.sigma))
+            * (qv
+                + (1.0 - qv)
+                    * term(
+                        self.shifted_velocity_distance(i, j),
+                        self.params.sigma_velocity,
+                    ))
     }
 
     /// The reconstructor of frames from PCA weights.
     pub fn reconstructor(&self) -> &Reconstructor {
         &self.reconstructor
     }
+}
+
+/// Checks the clips of [`JumpMap::analyze_cells`] and returns their common vertex count.
+fn validate_clips(clips: &[Clip<'_>]) -> Result<usize> {
+    const WHAT: &str = "JumpMap::analyze_cells";
+    let cell_err = |cell: usize, reason: String| AnimPcaError::InvalidCell {
+        what: WHAT,
+        cell,
+        reason,
+    };
+    let Some(first) = clips.first() else {
+        return Err(cell_err(0, "no clip given; pass at least one".into()));
+    };
+    let n = validate_clip(WHAT, first.positions)?;
+    for (k, clip) in clips.iter().enumerate() {
+        let nk = validate_clip(WHAT, clip.positions)?;
+        if nk != n {
+            return Err(cell_err(
+                k,
+                format!("{nk} vertices but cell 0 has {n}; cells share one mesh (thesis §3.2.2)"),
+            ));
+        }
+        if clip.normals.is_some() != first.normals.is_some() {
+            return Err(cell_err(
+                k,
+                "normals given for some cells but not all".into(),
+            ));
+        }
+        if let Some(nrm) = clip.normals {
+            if nrm.len() != clip.positions.len() {
+                return Err(cell_err(
+                    k,
+                    format!(
+                        "{} normal frames for {} position frames",
+                        nrm.len(),
+                        clip.positions.len()
+                    ),
+                ));
+            }
+            validate_frames("JumpMap::analyze_cells normals", nrm, n)?;
+        }
+        if clip.attributes.is_some() != first.attributes.is_some() {
+            return Err(cell_err(
+                k,
+                "attributes given for some cells but not all".into(),
+            ));
+        }
+        if let Some(attr) = clip.attributes {
+            if attr.len() != clip.positions.len() {
+                return Err(cell_err(
+                    k,
+                    format!(
+                        "{} attribute vectors for {} frames",
+                        attr.len(),
+                        clip.positions.len()
+                    ),
+                ));
+            }
+            let m = first.attributes.and_then(|a| a.first()).map_or(0, Vec::len);
+            if m == 0 {
+                return Err(cell_err(0, "attribute vectors are empty".into()));
+            }
+            for (i, r) in attr.iter().enumerate() {
+                if r.len() != m {
+                    return Err(cell_err(
+                        k,
+                        format!(
+                            "frame {i} has {} attributes, frame 0 of cell 0 has {m}",
+                            r.len()
+                        ),
+                    ));
+                }
+                if let Some(x) = r.iter().find(|x| !x.is_finite()) {
+                    return Err(cell_err(k, format!("frame {i} has the attribute {x}")));
+                }
+            }
+        }
+    }
+    Ok(n)
 }
 
 /// Checks a clip and returns its vertex count.
@@ -527,13 +810,13 @@ fn closing_neighbours(weights: &[f64], l: usize, c: usize) -> (Option<usize>, Op
 /// ends that a looping clip needs. Instead an end that closes onto another frame (see
 /// [`closing_neighbours`]) uses that frame's neighbour in the central difference, and any
 /// other end uses a one-sided difference (v_0 = p_1 − p_0, v_{l−1} = p_{l−1} − p_{l−2}).
-pub(crate) fn velocities(
-    positions: &[Vec<Vec3>],
+pub(crate) fn velocities<F: AsRef<[Vec3]>>(
+    positions: &[F],
     before_first: Option<usize>,
     after_last: Option<usize>,
 ) -> Vec<f32> {
     let l = positions.len();
-    let mut out = Vec::with_capacity(l * positions[0].len() * 3);
+    let mut out = Vec::with_capacity(l * positions[0].as_ref().len() * 3);
     for i in 0..l {
         let (a, b, s) = match i {
             0 => before_first.map_or((0, 1, 1.0), |k| (k, 1, 0.5)),
@@ -542,8 +825,9 @@ pub(crate) fn velocities(
         };
         out.extend(
             positions[a]
+                .as_ref()
                 .iter()
-                .zip(&positions[b])
+                .zip(positions[b].as_ref())
                 .flat_map(|(p, q)| ((*q - *p) * s).to_array()),
         );
     }
@@ -551,12 +835,12 @@ pub(crate) fn velocities(
 }
 
 /// Σ over frames and coordinates of the squared deviation from the mean frame, in f64.
-fn total_variance(frames: &[Vec<Vec3>]) -> f64 {
+fn total_variance(frames: &[&[Vec3]]) -> f64 {
     let l = frames.len() as f64;
     let n = frames[0].len();
     let mut mean = vec![[0.0f64; 3]; n];
     for f in frames {
-        for (m, v) in mean.iter_mut().zip(f) {
+        for (m, v) in mean.iter_mut().zip(f.iter()) {
             for k in 0..3 {
                 m[k] += f64::from(v[k]) / l;
             }

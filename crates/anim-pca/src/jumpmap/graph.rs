@@ -17,6 +17,7 @@
 //! Frames outside the core (a lead-in before a cycle, a clip end that matches nothing) are
 //! therefore played only on the way into the core, never again.
 
+use super::cells::Layout;
 use crate::matrix::SquareMatrix;
 
 /// An edge i → j is significant when P̂_ij is at least this fraction of row i's maximum.
@@ -29,6 +30,30 @@ pub const SIGNIFICANT_FRACTION: f64 = 1e-3;
 pub(crate) struct Pruned {
     pub sampling: SquareMatrix,
     pub in_core: Vec<bool>,
+}
+
+/// [`prune`] cell by cell (see [`JumpMap::analyze_cells`](super::JumpMap::analyze_cells)): each cell gets its own core and the
+/// sampling matrix is block-diagonal, so random play stays inside its cell. Crossing into
+/// another cell is the player's motion control, never a random draw.
+pub(crate) fn prune_cells(p_hat: &SquareMatrix, layout: &Layout) -> Pruned {
+    if layout.ranges().len() == 1 {
+        return prune(p_hat);
+    }
+    let l = p_hat.n();
+    let mut sampling = SquareMatrix::zeros(l);
+    let mut in_core = vec![false; l];
+    for r in layout.ranges() {
+        let mut sub = SquareMatrix::from_fn(r.len(), |a, b| p_hat.get(r.start + a, r.start + b));
+        for a in 0..r.len() {
+            super::probability::normalise_row(sub.row_mut(a));
+        }
+        let part = prune(&sub);
+        for a in 0..r.len() {
+            sampling.row_mut(r.start + a)[r.clone()].copy_from_slice(part.sampling.row(a));
+            in_core[r.start + a] = part.in_core[a];
+        }
+    }
+    Pruned { sampling, in_core }
 }
 
 /// Computes the core and the pruned sampling matrix of the row-normalised jump map `p_hat`.

@@ -9,8 +9,13 @@
 //!    jump map P̂ (eq. 3.8), then a dead-end pruning pass ([`graph`]).
 //! 2. [`Player`]: endless random play with a memory of m < 5 frames, blended (eq. 3.9–3.10)
 //!    or variable-length (eq. 3.11) transitions, deterministic for a seed.
-//! 3. [`Reconstructor`]: frames from weights (eq. 3.1), f32, allocation-free.
-//! 4. [`metrics`]: E(c), E*(c) (eqs. 3.12–3.13) and measures of a generated sequence.
+//!    Several clips analysed together are *cells* ([`JumpMap::analyze_cells`]): random play
+//!    stays in its cell, and [`Player::set_target_cell`] moves to another one at the best
+//!    transition ahead (§3.2.2 "Motion Control").
+//! 3. [`LoopTable`]: the cheapest fixed-length loop of every length (Fig. 3.2, [`loops`]).
+//! 4. [`Reconstructor`]: frames from weights (eq. 3.1), f32, allocation-free; attribute
+//!    vectors R_i have a PCA and an [`AttributeReconstructor`] of their own.
+//! 5. [`metrics`]: E(c), E*(c) (eqs. 3.12–3.13) and measures of a generated sequence.
 //!
 //! # Deviations from the thesis, and why
 //! * **Distance unit.** D and D* are divided by their mean off-diagonal entry, so σ, σ* are
@@ -27,13 +32,16 @@
 //! * **P̂** is row-normalised after eq. 3.8 so that it can be sampled.
 
 pub mod graph;
+pub mod loops;
 pub mod metrics;
 pub mod player;
 pub mod probability;
 
 mod analysis;
+mod cells;
 mod reconstruct;
 
-pub use analysis::{CLOSING_MATCH, JumpMap, JumpMapParams};
+pub use analysis::{CLOSING_MATCH, Clip, JumpMap, JumpMapParams};
+pub use loops::{Loop, LoopTable};
 pub use player::{Blend, Generated, GeneratedFrame, PlaybackParams, Player, Transition};
-pub use reconstruct::Reconstructor;
+pub use reconstruct::{AttributeReconstructor, Reconstructor};

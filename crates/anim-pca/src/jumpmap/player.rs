@@ -49,6 +49,9 @@ pub const MAX_MEMORY_EXCLUSIVE: usize = 5;
 /// no longer a transition but new motion. Set to about one second at 30 fps.
 pub const MAX_BLEND_FRAMES: usize = 32;
 
+/// Default [`PlaybackParams::control_horizon`]: about one second at 30 fps.
+pub const DEFAULT_CONTROL_HORIZON: usize = 30;
+
 const WHAT: &str = "Player::new";
 
 /// How transitions are blended.
@@ -75,6 +78,9 @@ pub struct PlaybackParams {
     pub start_frame: usize,
     /// Seed of the ChaCha8 stream that draws the jumps.
     pub seed: u64,
+    /// How many frames ahead the player looks for the best place to leave its cell after
+    /// [`Player::set_target_cell`] (≥ 1; the thesis's motion control, §3.2.2).
+    pub control_horizon: usize,
 }
 
 impl Default for PlaybackParams {
@@ -84,6 +90,7 @@ impl Default for PlaybackParams {
             blend: Blend::Fixed(3),
             start_frame: 0,
             seed: 0,
+            control_horizon: DEFAULT_CONTROL_HORIZON,
         }
     }
 }
@@ -113,6 +120,23 @@ impl GeneratedFrame {
     /// Whether this is a plain clip frame.
     pub fn is_key(&self) -> bool {
         self.from == self.to || self.alpha == 0.0
+    }
+
+    /// Its attribute weights into `out` (length
+    /// [`AttributeReconstructor::components`](super::AttributeReconstructor::components);
+    /// nothing to do for a map without attributes).
+    ///
+    /// # Panics
+    /// If `out` has the wrong length or the frame indices are out of the map's range.
+    pub fn attribute_weights_into(&self, map: &JumpMap, out: &mut [f64]) {
+        let (a, b) = (
+            map.attribute_weights(self.from),
+            map.attribute_weights(self.to),
+        );
+        assert_eq!(out.len(), a.len(), "attribute weights buffer length");
+        for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+            *o = (1.0 - self.alpha) * x + self.alpha * y;
+        }
     }
 
     /// Its PCA weights into `out` (length [`JumpMap::components`]).
@@ -161,6 +185,7 @@ pub struct Player<'a> {
     queue: VecDeque<GeneratedFrame>,
     emitted: usize,
     last_transition: Option<Transition>,
+    target_cell: Option<usize>,
 }
 
 impl<'a> Player<'a> {
@@ -215,6 +240,7 @@ impl<'a> Player<'a> {
             queue,
             emitted: 0,
             last_transition: None,
+            target_cell: None,
         })
     }
 
@@ -257,22 +283,31 @@ impl<'a> Player<'a> {
             .unwrap_or(GeneratedFrame::key(self.current))
     }
 
-    /// Draws the next key frame and queues the blend frames and the key frame.
+    /// Draws the next key frame and queues the blend frames and the key frame; carries out a
+    /// pending cell change instead when there is one.
     fn schedule(&mut self) {
-        let l = self.map.n_frames();
+        let layout = self.map.layout();
         let i = self.current;
-        let j = self.choose(i);
-        if i + 1 != j {
-            let b = self.blend_frames(i, j).min(l - 1 - i).min(j);
-            for t in 1..=b {
-                self.queue.push_back(GeneratedFrame {
-                    from: i + t,
-                    to: j + t - (b + 1),
-                    alpha: t as f64 / (b + 1) as f64,
-                });
+        let j = match self.target_cell.take() {
+            Some(cell) => {
+                let (k, j) = self.route(i, cell);
+                let mut at = i;
+                while at != k {
+                    at += 1; // k lies on the natural path from i
+                    self.queue.push_back(GeneratedFrame::key(at));
+                    self.remember(at);
+                }
+                self.current = k;
+                j
             }
+            None => self.choose(i),
+        };
+        let i = self.current;
+        if layout.is_jump(i, j) {
+            let b = blend_frames(self.map, self.params.blend, i, j);
+            self.queue.extend(blend_sequence(i, j, b));
             self.last_transition = Some(Transition {
-                index: self.emitted - 1,
+                index: self.emitted + self.queue.len() - b - 1,
                 from: i,
                 to: j,
                 blend_frames: b,
@@ -280,6 +315,10 @@ impl<'a> Player<'a> {
         }
         self.queue.push_back(GeneratedFrame::key(j));
         self.current = j;
+        self.remember(j);
+    }
+
+    fn remember(&mut self, j: usize) {
         if self.params.memory > 0 {
             if self.memory.len() == self.params.memory {
                 self.memory.pop_front();
@@ -288,25 +327,67 @@ impl<'a> Player<'a> {
         }
     }
 
-    /// b for the transition i → j (before shortening at the clip ends).
-    fn blend_frames(&self, i: usize, j: usize) -> usize {
-        match self.params.blend {
-            Blend::None => 0,
-            Blend::Fixed(b) => b,
-            Blend::Smoothness(s) => {
-                let unit = s * self.map.mean_frame_distance();
-                if unit > 0.0 {
-                    let b = (self.map.jump_residual(i, j) / unit).round();
-                    if b.is_finite() {
-                        (b as usize).min(MAX_BLEND_FRAMES)
-                    } else {
-                        MAX_BLEND_FRAMES
-                    }
-                } else {
-                    0
+    /// The cell the player is in (that of [`Player::current_key`]).
+    pub fn current_cell(&self) -> usize {
+        self.map.cell_of(self.current)
+    }
+
+    /// Motion control (thesis §3.2.2, Fig. 3.5): asks the player to move into cell `cell`.
+    ///
+    /// When the frames already queued have played, the player looks ahead along the natural
+    /// play of its current cell, up to [`PlaybackParams::control_horizon`] frames (or the
+    /// cell's end), for the frame k and the target-cell core frame j with the best
+    /// [`JumpMap::transition_score`] (earliest on ties), plays on to k, blends into j as any
+    /// transition, and from then on plays randomly inside the target cell. Asking for the
+    /// current cell cancels a pending request.
+    ///
+    /// # Errors
+    /// [`crate::AnimPcaError::InvalidCell`] if `cell ≥ n_cells()`.
+    pub fn set_target_cell(&mut self, cell: usize) -> Result<()> {
+        if cell >= self.map.n_cells() {
+            return Err(crate::AnimPcaError::InvalidCell {
+                what: "Player::set_target_cell",
+                cell,
+                reason: format!("the map has {} cell(s)", self.map.n_cells()),
+            });
+        }
+        self.target_cell = (cell != self.current_cell()).then_some(cell);
+        Ok(())
+    }
+
+    /// The pending target cell, if a request has not been carried out yet.
+    pub fn target_cell(&self) -> Option<usize> {
+        self.target_cell
+    }
+
+    /// The exit frame k (on the natural path from `i`) and entry frame j into `cell`.
+    fn route(&self, i: usize, cell: usize) -> (usize, usize) {
+        let map = self.map;
+        let layout = map.layout();
+        let targets: Vec<usize> = map.cell_range(cell).filter(|&j| map.core()[j]).collect();
+        let mut best: Option<(f64, usize, usize)> = None;
+        let mut k = i;
+        for _ in 0..=self.params.control_horizon.max(1) {
+            for &j in &targets {
+                if !layout.is_candidate(k, j) {
+                    continue;
+                }
+                let score = map.transition_score(k, j);
+                if best.is_none_or(|(b, _, _)| score > b) {
+                    best = Some((score, k, j));
                 }
             }
+            match layout.successor(k) {
+                Some(next) => k = next,
+                None => break,
+            }
         }
+        // Every core frame with a predecessor is a candidate from a cell's last frame, and
+        // every frame is one from any other frame; a 1-candidate-less route can only happen
+        // for a target core without such frames: enter at the core's first frame.
+        best.map_or((i, targets.first().copied().unwrap_or(i)), |(_, k, j)| {
+            (k, j)
+        })
     }
 
     /// Samples row i of the sampling matrix, avoiding the memory (see the module docs).
@@ -318,23 +399,66 @@ impl<'a> Player<'a> {
             .sum();
         if masked > 0.0 {
             let memory = &self.memory;
-            return sample(&mut self.rng, row, masked, |j| !memory.contains(&j), i);
+            let fallback = self.map.successor(i).unwrap_or(i);
+            return sample(
+                &mut self.rng,
+                row,
+                masked,
+                |j| !memory.contains(&j),
+                fallback,
+            );
         }
-        if i + 1 < row.len() && row[i + 1] > 0.0 {
-            return i + 1;
+        let fallback = self.map.successor(i).unwrap_or(i);
+        if fallback != i && row[fallback] > 0.0 {
+            return fallback;
         }
         let total: f64 = row.iter().sum();
-        sample(&mut self.rng, row, total, |_| true, i)
+        sample(&mut self.rng, row, total, |_| true, fallback)
     }
 }
 
-/// Draws j with probability row[j] / total among the allowed j (`i + 1` mod l if none).
+/// Blend frames b for the transition i → j under `blend` (eq. 3.9, or eq. 3.11 for a
+/// smoothness), shortened so that both streams stay inside their cells:
+/// b' = min(b, last(i) − i, j − first(j)).
+pub(crate) fn blend_frames(map: &JumpMap, blend: Blend, i: usize, j: usize) -> usize {
+    let b = match blend {
+        Blend::None => 0,
+        Blend::Fixed(b) => b,
+        Blend::Smoothness(s) => {
+            let unit = s * map.mean_frame_distance();
+            if unit > 0.0 {
+                let b = (map.jump_residual(i, j) / unit).round();
+                if b.is_finite() {
+                    (b as usize).min(MAX_BLEND_FRAMES)
+                } else {
+                    MAX_BLEND_FRAMES
+                }
+            } else {
+                0
+            }
+        }
+    };
+    let (ri, rj) = (map.layout().range_of(i), map.layout().range_of(j));
+    b.min(ri.end - 1 - i).min(j - rj.start)
+}
+
+/// The b blend frames of eq. 3.9 for i → j: (1 − α_t)·w_{i+t} + α_t·w_{j−(b+1)+t},
+/// α_t = t/(b+1), t = 1 … b (see the module docs).
+pub(crate) fn blend_sequence(i: usize, j: usize, b: usize) -> impl Iterator<Item = GeneratedFrame> {
+    (1..=b).map(move |t| GeneratedFrame {
+        from: i + t,
+        to: j + t - (b + 1),
+        alpha: t as f64 / (b + 1) as f64,
+    })
+}
+
+/// Draws j with probability row[j] / total among the allowed j (`fallback` if none).
 fn sample(
     rng: &mut ChaCha8Rng,
     row: &[f64],
     total: f64,
     allowed: impl Fn(usize) -> bool,
-    i: usize,
+    fallback: usize,
 ) -> usize {
     let u = (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
     let target = u * total;
@@ -350,7 +474,7 @@ fn sample(
         }
     }
     // Rounding left `target` just above the sum: take the last allowed candidate.
-    last.unwrap_or((i + 1) % row.len())
+    last.unwrap_or(fallback)
 }
 
 impl Iterator for Player<'_> {

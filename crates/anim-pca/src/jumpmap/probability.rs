@@ -12,10 +12,14 @@
 //!   j looks like the last frame" (j = 0 has no predecessor and j = l−1 would be a standstill,
 //!   so both get 0). A cyclic clip whose last frame repeats frame 0 thus continues at frame 1.
 //!   A 2-frame clip has no such j; its last row restarts at frame 0 with probability 1.
+//!   With several cells ([`JumpMap::analyze_cells`](super::JumpMap::analyze_cells)) the last
+//!   frame of every cell follows this rule, with "any j ≠ i whose predecessor is in j's own
+//!   cell" in place of 1..=l−2, and D_{i,j−1} in place of D_{l−1,j−1}.
 //! * Rows are computed as exp(−(D − D_min)/σ) before normalising, so σ → 0 leaves the best
 //!   candidates (probability 1/#ties) and σ → ∞ (σ = +∞ is accepted) gives a uniform row;
 //!   nothing overflows or divides by zero.
 
+use super::cells::Layout;
 use crate::matrix::SquareMatrix;
 
 /// D_ij = Σ_k |w_ik − w_jk| for `weights` (l × c, row-major), accumulated in f64 (eq. 3.2).
@@ -56,24 +60,13 @@ pub(crate) fn normalise_by_mean_off_diagonal(d: &mut SquareMatrix) -> f64 {
     }
 }
 
-/// Whether the transition i → j exists at all (the last row's rule, see the module docs).
-pub(crate) fn is_candidate(l: usize, i: usize, j: usize) -> bool {
-    if i + 1 < l {
-        true
-    } else if l == 2 {
-        j == 0
-    } else {
-        (1..=l - 2).contains(&j)
-    }
-}
-
-/// The cost whose exponential gives P_ij (eq. 3.3): D_{i+1,j}, or D_{l−1,j−1} on the last row.
-pub(crate) fn shifted_cost(d: &SquareMatrix, i: usize, j: usize) -> f64 {
-    let l = d.n();
-    if i + 1 < l {
-        d.get(i + 1, j)
-    } else if j >= 1 {
-        d.get(l - 1, j - 1)
+/// The cost whose exponential gives P_ij (eq. 3.3): D_{i+1,j}, or D_{i,j−1} from the last
+/// frame of a cell (the predecessor rule, see the module docs); 0 where neither exists.
+pub(crate) fn shifted_cost(layout: &Layout, d: &SquareMatrix, i: usize, j: usize) -> f64 {
+    if let Some(s) = layout.successor(i) {
+        d.get(s, j)
+    } else if let Some(p) = layout.predecessor(j) {
+        d.get(i, p)
     } else {
         0.0
     }
@@ -81,18 +74,22 @@ pub(crate) fn shifted_cost(d: &SquareMatrix, i: usize, j: usize) -> f64 {
 
 /// P (eq. 3.3) or P* (eq. 3.6) from a normalised distance matrix and σ > 0 (may be +∞),
 /// row-normalised, zero outside the candidates.
-pub(crate) fn transition_probabilities(d: &SquareMatrix, sigma: f64) -> SquareMatrix {
+pub(crate) fn transition_probabilities(
+    layout: &Layout,
+    d: &SquareMatrix,
+    sigma: f64,
+) -> SquareMatrix {
     let l = d.n();
     let mut p = SquareMatrix::zeros(l);
     for i in 0..l {
         let min = (0..l)
-            .filter(|&j| is_candidate(l, i, j))
-            .map(|j| shifted_cost(d, i, j))
+            .filter(|&j| layout.is_candidate(i, j))
+            .map(|j| shifted_cost(layout, d, i, j))
             .fold(f64::INFINITY, f64::min);
         let row = p.row_mut(i);
         for (j, x) in row.iter_mut().enumerate() {
-            if is_candidate(l, i, j) {
-                let excess = shifted_cost(d, i, j) - min;
+            if layout.is_candidate(i, j) {
+                let excess = shifted_cost(layout, d, i, j) - min;
                 // excess ≥ 0 is finite; excess/∞ = 0 and 0/σ = 0, so this is never NaN.
                 *x = (-(excess / sigma)).exp();
             }
@@ -104,10 +101,16 @@ pub(crate) fn transition_probabilities(d: &SquareMatrix, sigma: f64) -> SquareMa
 
 /// P̂_ij = [q + (1−q)P_ij][q* + (1−q*)P*_ij] (eq. 3.8), restricted to the candidates and
 /// row-normalised for sampling (eq. 3.8's entries lie in [0, 1] but do not sum to 1).
-pub(crate) fn jump_map(p: &SquareMatrix, pv: &SquareMatrix, q: f64, qv: f64) -> SquareMatrix {
+pub(crate) fn jump_map(
+    layout: &Layout,
+    p: &SquareMatrix,
+    pv: &SquareMatrix,
+    q: f64,
+    qv: f64,
+) -> SquareMatrix {
     let l = p.n();
     let mut out = SquareMatrix::from_fn(l, |i, j| {
-        if is_candidate(l, i, j) {
+        if layout.is_candidate(i, j) {
             (q + (1.0 - q) * p.get(i, j)) * (qv + (1.0 - qv) * pv.get(i, j))
         } else {
             0.0

@@ -124,7 +124,11 @@ impl Reconstructor {
 
 /// out = mean + Σ_k w_k comps_k over flat f32 arrays.
 fn combine(mean: &[f32], comps: &[f32], weights: &[f64], out: &mut [Vec3]) {
-    let flat: &mut [f32] = bytemuck::cast_slice_mut(out);
+    combine_flat(mean, comps, weights, bytemuck::cast_slice_mut(out));
+}
+
+/// out = mean + Σ_k w_k comps_k.
+fn combine_flat(mean: &[f32], comps: &[f32], weights: &[f64], flat: &mut [f32]) {
     flat.copy_from_slice(mean);
     let d = mean.len();
     for (k, &w) in weights.iter().enumerate() {
@@ -132,5 +136,73 @@ fn combine(mean: &[f32], comps: &[f32], weights: &[f64], out: &mut [Vec3]) {
         for (o, f) in flat.iter_mut().zip(&comps[k * d..(k + 1) * d]) {
             *o += w * f;
         }
+    }
+}
+
+/// Rebuilds a frame's attribute vector R̃_i = R̄ + Σ_k r_k G_k from its attribute weights (the
+/// separate vector of thesis §3.2.2 "Adding vertex attributes"; see
+/// [`JumpMap::analyze_cells`](super::JumpMap::analyze_cells)). Allocates nothing per call.
+#[derive(Clone, Debug)]
+pub struct AttributeReconstructor {
+    len: usize,
+    c: usize,
+    mean: Vec<f32>,
+    components: Vec<f32>,
+}
+
+impl AttributeReconstructor {
+    pub(crate) fn from_pca(pca: &Pca) -> Self {
+        let len = pca.mean().len();
+        let c = pca.n_components();
+        let mut components = Vec::with_capacity(c * len);
+        for k in 0..c {
+            components.extend(pca.component(k).iter().map(|&x| x as f32));
+        }
+        Self {
+            len,
+            c,
+            mean: pca.mean().iter().map(|&x| x as f32).collect(),
+            components,
+        }
+    }
+
+    /// Number of attribute components the weights must have.
+    pub fn components(&self) -> usize {
+        self.c
+    }
+
+    /// Length of an attribute vector R_i.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether R_i is empty (never, for a map built from attributes).
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// R̃ = R̄ + Σ_k r_k G_k into `out` (length [`AttributeReconstructor::len`]); `weights` may
+    /// be shorter than c.
+    ///
+    /// # Errors
+    /// [`AnimPcaError::LengthMismatch`] if `weights` has more than c entries or `out` has the
+    /// wrong length.
+    pub fn reconstruct(&self, weights: &[f64], out: &mut [f32]) -> Result<()> {
+        if weights.len() > self.c {
+            return Err(AnimPcaError::LengthMismatch {
+                what: "AttributeReconstructor weights",
+                expected: self.c,
+                found: weights.len(),
+            });
+        }
+        if out.len() != self.len {
+            return Err(AnimPcaError::LengthMismatch {
+                what: "AttributeReconstructor output",
+                expected: self.len,
+                found: out.len(),
+            });
+        }
+        combine_flat(&self.mean, &self.components, weights, out);
+        Ok(())
     }
 }
