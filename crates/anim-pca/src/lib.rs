@@ -54,6 +54,6 @@ pub use error::{AnimPcaError, Result};
 pub use jumpmap::metrics::{ReconstructionError, SequenceStats};
 pub use jumpmap::{
     AttributeReconstructor, Blend, Clip, Generated, GeneratedFrame, JumpMap, JumpMapParams, Loop,
-    LoopTable, PlaybackParams, Player, Reconstructor, Transition,
+    LoopTable, PlaybackParams, Player, Reconstructor, RootMotion, Transition,
 };
 pub use matrix::SquareMatrix;

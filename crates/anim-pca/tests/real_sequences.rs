@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use anim_pca::jumpmap::metrics::{reconstruction_errors, sequence_stats};
-use anim_pca::{JumpMap, JumpMapParams, PlaybackParams, Player};
+use anim_pca::{JumpMap, JumpMapParams, PlaybackParams, Player, RootMotion};
 
 fn load(rel: &str) -> Option<Vec<Vec<glam::Vec3>>> {
     let path = test_data::shared_file(rel)?;
@@ -74,4 +74,35 @@ fn chicken_crossing_plays() {
     };
     let map = report("chickenCrossing", &frames);
     assert!(map.core().iter().filter(|c| **c).count() >= 2);
+}
+
+#[test]
+fn chicken_crossing_with_root_motion_extracted() {
+    let Some(frames) = load("anim/chickenCrossing") else {
+        return;
+    };
+    let core = |root_motion| {
+        let params = JumpMapParams {
+            root_motion,
+            ..JumpMapParams::default()
+        };
+        let map = JumpMap::analyze(&frames, &params).unwrap();
+        let run = Player::new(&map, &PlaybackParams::default())
+            .unwrap()
+            .generate(20_000);
+        let stats = sequence_stats(&map, &run);
+        let n = map.core().iter().filter(|c| **c).count();
+        println!(
+            "chickenCrossing {root_motion:?}: core {n}/{}, {stats:?}",
+            frames.len()
+        );
+        (n, stats)
+    };
+    let (kept, _) = core(RootMotion::Keep);
+    let (extracted, stats) = core(RootMotion::Extract);
+    assert!(
+        extracted >= kept,
+        "extraction shrank the core: {extracted} < {kept}"
+    );
+    assert!(stats.transitions > 0);
 }

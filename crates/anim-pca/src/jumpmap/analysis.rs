@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::cells::Layout;
 use super::graph;
+use super::player::GeneratedFrame;
 use super::probability::{
     jump_map, l1_distances, normalise_by_mean_off_diagonal, shifted_cost, transition_probabilities,
 };
@@ -44,6 +45,27 @@ pub struct JumpMapParams {
     pub normal_weight: f64,
     /// Components of the separate attribute PCA (R_i, [`Clip::with_attributes`]); ≥ 1.
     pub attribute_components: usize,
+    /// Whether the clip's travel through the scene is analysed with the shape or taken out
+    /// first (see [`RootMotion`]).
+    pub root_motion: RootMotion,
+}
+
+/// What to do with a clip's global translation (its *root motion*).
+///
+/// The thesis's sequences move in place. A clip that travels (a walk across a room) never
+/// returns to an earlier position, so no frame resembles a frame a period earlier and the jump
+/// map finds almost nothing: D measures where the body is, not what it does. Extracting the root motion analyses the *shape* — every frame moved so that
+/// its vertex centroid is at the origin — and plays the travel back by integrating the
+/// clip's own centroid velocities along the generated frames ([`JumpMap::root_offsets`]), as
+/// game engines do with root motion.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RootMotion {
+    /// Analyse positions as given (the thesis's method).
+    #[default]
+    Keep,
+    /// Remove each frame's vertex centroid before the analysis and replay it as integrated
+    /// velocity.
+    Extract,
 }
 
 impl Default for JumpMapParams {
@@ -57,6 +79,7 @@ impl Default for JumpMapParams {
             q_velocity: 0.0,
             normal_weight: 1.0,
             attribute_components: 4,
+            root_motion: RootMotion::Keep,
         }
     }
 }
@@ -191,6 +214,7 @@ pub struct JumpMap {
     sampling: SquareMatrix,
     in_core: Vec<bool>,
     mean_step: f64,
+    roots: Vec<Vec3>,
     reconstructor: Reconstructor,
 }
 
@@ -288,10 +312,30 @@ impl JumpMap {
         let n_vertices = validate_clips(clips)?;
         let layout = Layout::new(&clips.iter().map(|c| c.positions.len()).collect::<Vec<_>>());
         let l = layout.n();
-        let positions: Vec<&[Vec3]> = clips
-            .iter()
-            .flat_map(|c| c.positions.iter().map(Vec::as_slice))
-            .collect();
+        let (centred, roots) = match params.root_motion {
+            RootMotion::Keep => (Vec::new(), vec![Vec3::ZERO; l]),
+            RootMotion::Extract => {
+                let roots: Vec<Vec3> = clips
+                    .iter()
+                    .flat_map(|c| c.positions.iter().map(|f| centroid(f)))
+                    .collect();
+                let centred: Vec<Vec<Vec3>> = clips
+                    .iter()
+                    .flat_map(|c| c.positions.iter())
+                    .zip(&roots)
+                    .map(|(f, r)| f.iter().map(|v| *v - *r).collect())
+                    .collect();
+                (centred, roots)
+            }
+        };
+        let positions: Vec<&[Vec3]> = if centred.is_empty() {
+            clips
+                .iter()
+                .flat_map(|c| c.positions.iter().map(Vec::as_slice))
+                .collect()
+        } else {
+            centred.iter().map(Vec::as_slice).collect()
+        };
         let normals: Option<Vec<&[Vec3]>> = clips[0].normals.is_some().then(|| {
             clips
                 .iter()
@@ -334,6 +378,8 @@ impl JumpMap {
         let velocity_pca = fit(v, params.velocity_components)?;
         let velocity_weights = flatten(&velocity_pca.project(v)?);
         drop(vel);
+        drop(positions);
+        drop(centred);
 
         // R_i: a PCA of its own.
         let attributes = match clips[0].attributes {
@@ -382,6 +428,7 @@ impl JumpMap {
             sampling: pruned.sampling,
             in_core: pruned.in_core,
             mean_step: 0.0,
+            roots,
             reconstructor,
         };
         let steps: Vec<f64> = (0..l)
@@ -613,6 +660,49 @@ impl JumpMap {
                     ))
     }
 
+    /// The extracted root position (vertex centroid) of clip frame i; zero when the root
+    /// motion was kept ([`RootMotion::Keep`]).
+    ///
+    /// # Panics
+    /// If `i ≥ n_frames()`.
+    pub fn root(&self, i: usize) -> Vec3 {
+        self.roots[i]
+    }
+
+    /// The root's velocity at clip frame i: root(i + 1) − root(i), or root(i) − root(i − 1) at
+    /// the end of a cell (cells have ≥ 2 frames, so one of the two exists).
+    pub fn root_velocity(&self, i: usize) -> Vec3 {
+        match (self.layout.successor(i), self.layout.predecessor(i)) {
+            (Some(s), _) => self.roots[s] - self.roots[i],
+            (None, Some(p)) => self.roots[i] - self.roots[p],
+            (None, None) => Vec3::ZERO,
+        }
+    }
+
+    /// Where to put each generated frame: the offset to add to its reconstructed vertices.
+    ///
+    /// With [`RootMotion::Extract`] the offsets integrate the clip's root velocities along the
+    /// run, starting at the root of `frames[0]`: o_0 = root(`frames[0]`), o_{t+1} = o_t + v_t,
+    /// where v_t blends the root velocities of frame t's two clip frames with its α. A
+    /// walk therefore keeps walking forward through jumps and blends instead of snapping back
+    /// to where the clip frame was recorded. With [`RootMotion::Keep`] all offsets are zero
+    /// (the reconstructed frames are already in place).
+    pub fn root_offsets(&self, frames: &[GeneratedFrame]) -> Vec<Vec3> {
+        if self.params.root_motion == RootMotion::Keep {
+            return vec![Vec3::ZERO; frames.len()];
+        }
+        let mut out = Vec::with_capacity(frames.len());
+        let mut o = frames.first().map_or(Vec3::ZERO, |f| {
+            self.roots[f.from].lerp(self.roots[f.to], f.alpha as f32)
+        });
+        for f in frames {
+            out.push(o);
+            let a = f.alpha as f32;
+            o += self.root_velocity(f.from) * (1.0 - a) + self.root_velocity(f.to) * a;
+        }
+        out
+    }
+
     /// The reconstructor of frames from PCA weights.
     pub fn reconstructor(&self) -> &Reconstructor {
         &self.reconstructor
@@ -832,6 +922,18 @@ pub(crate) fn velocities<F: AsRef<[Vec3]>>(
         );
     }
     out
+}
+
+/// The vertex centroid of a frame, accumulated in f64.
+fn centroid(frame: &[Vec3]) -> Vec3 {
+    let mut s = [0.0f64; 3];
+    for v in frame {
+        for k in 0..3 {
+            s[k] += f64::from(v[k]);
+        }
+    }
+    let n = frame.len().max(1) as f64;
+    Vec3::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32)
 }
 
 /// Σ over frames and coordinates of the squared deviation from the mean frame, in f64.

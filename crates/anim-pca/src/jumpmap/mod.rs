@@ -41,7 +41,7 @@ mod analysis;
 mod cells;
 mod reconstruct;
 
-pub use analysis::{CLOSING_MATCH, Clip, JumpMap, JumpMapParams};
+pub use analysis::{CLOSING_MATCH, Clip, JumpMap, JumpMapParams, RootMotion};
 pub use loops::{Loop, LoopTable};
 pub use player::{Blend, Generated, GeneratedFrame, PlaybackParams, Player, Transition};
 pub use reconstruct::{AttributeReconstructor, Reconstructor};
