@@ -1,11 +1,12 @@
 //! The speed targets as a benchmark: analysis of a 20k-vertex, 200-frame clip
 //! (target ≤ 2 s on the development machine) and playback with reconstruction from c = 10
-//! weights (target ≥ 1,000 frames/s on the CPU). Run with
+//! weights (target ≥ 1,000 frames/s on the CPU), and the loop table of every length up to
+//! 200 frames over the same clip. Run with
 //! `cargo bench -p anim-pca --bench jumpmap`.
 
 use std::f32::consts::TAU;
 
-use anim_pca::{JumpMap, JumpMapParams, PlaybackParams, Player};
+use anim_pca::{Blend, JumpMap, JumpMapParams, LoopTable, PlaybackParams, Player};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 
@@ -43,6 +44,9 @@ fn jumpmap(c: &mut Criterion) {
     let mut player = Player::new(&map, &PlaybackParams::default()).expect("valid params");
     let mut weights = vec![0.0; map.components()];
     let mut mesh = vec![Vec3::ZERO; map.n_vertices()];
+    group.bench_function("loop table, lengths 2..=200, b=3, 200 frames", |b| {
+        b.iter(|| LoopTable::build(&map, 0, 200, Blend::Fixed(3)).expect("valid"));
+    });
     group.throughput(Throughput::Elements(1));
     group.bench_function("play + reconstruct one frame, 20164 v, c=10", |b| {
         b.iter(|| {

@@ -97,6 +97,40 @@ pub enum AnimPcaError {
         /// What is wrong and how to fix it.
         reason: String,
     },
+    /// A `.cpca` file (thesis §3.3) is shorter than its header or a section says.
+    #[error(
+        "cpca file: {section} needs {needed} bytes but only {available} remain; the file is \
+         truncated — copy or download it again"
+    )]
+    Truncated {
+        /// The part being read, e.g. `"header"` or `"section WGHT"`.
+        section: &'static str,
+        /// Bytes needed.
+        needed: u64,
+        /// Bytes left in the file.
+        available: u64,
+    },
+    /// The CRC-32 at the end of a `.cpca` file does not match its contents.
+    #[error(
+        "cpca file: checksum mismatch (stored {stored:#010x}, computed {computed:#010x}); the \
+         file is corrupt — copy or download it again"
+    )]
+    ChecksumMismatch {
+        /// CRC-32 stored in the file.
+        stored: u32,
+        /// CRC-32 of the bytes read.
+        computed: u32,
+    },
+    /// A `.cpca` file has a field with an impossible or unsupported value.
+    #[error("cpca file: field `{field}` = {value} is invalid: {reason}")]
+    InvalidFile {
+        /// The field, e.g. `"version"` or `"clusters"`.
+        field: &'static str,
+        /// The value found, printed.
+        value: String,
+        /// What was expected.
+        reason: &'static str,
+    },
     /// The PCA failed (see the inner error).
     #[error("PCA of the clip failed: {0}")]
     Pca(#[from] ClusteringError),

@@ -13,6 +13,8 @@
 //! * [`LoopTable`] — the cheapest fixed-length loop of every length (Fig. 3.2).
 //! * [`Reconstructor`] — frames from weights (eq. 3.1).
 //! * [`jumpmap::metrics`] — E(c), E*(c) (eqs. 3.12–3.13) and quality of a generated run.
+//! * [`compress`] — clustered-PCA compression (§3.3): encoder, `.cpca` container, random-access
+//!   CPU decoder, d_a/d_f and bpvf (eqs. 3.14–3.18).
 //!
 //! Where the implementation departs from the printed equations (the distance unit, the last
 //! frame, eq. 3.10) is listed in [`jumpmap`]. Frames come in as `glam::Vec3` per vertex; the
@@ -46,10 +48,12 @@
 //! assert!(!run.transitions.is_empty()); // it did loop
 //! ```
 
+pub mod compress;
 mod error;
 pub mod jumpmap;
 mod matrix;
 
+pub use compress::{Compressed, CpcaModel, CpcaParams, Decoder};
 pub use error::{AnimPcaError, Result};
 pub use jumpmap::metrics::{ReconstructionError, SequenceStats};
 pub use jumpmap::{
