@@ -131,6 +131,27 @@ pub enum AnimPcaError {
         /// What was expected.
         reason: &'static str,
     },
+    /// A GPU buffer would exceed a limit of the device (`compress::GpuDecoder`).
+    #[error(
+        "{what}: {value} exceeds the device limit {maximum}; request a device with larger \
+         limits, or compress with fewer frames, components or with time components"
+    )]
+    GpuLimit {
+        /// The buffer, e.g. `"GpuDecoder rows bytes"`.
+        what: &'static str,
+        /// Its size.
+        value: u64,
+        /// The device's limit, also capped at 2³² − 1 elements (the shader's u32 indices).
+        maximum: u64,
+    },
+    /// Reading a GPU buffer back failed (the device was lost or the mapping failed).
+    #[error("{what}: reading the GPU buffer back failed: {reason}; check the GPU driver")]
+    GpuReadback {
+        /// The call that read back.
+        what: &'static str,
+        /// The error reported by wgpu.
+        reason: String,
+    },
     /// The PCA failed (see the inner error).
     #[error("PCA of the clip failed: {0}")]
     Pca(#[from] ClusteringError),

@@ -13,7 +13,9 @@
 //!    ("Quantization", [`Quantized`]); [`Compressed`].
 //! 5. [`Compressed::to_bytes`] writes the `.cpca` container ([`mod@format`]), and
 //!    [`Compressed::from_bytes`] reads it back with every field validated.
-//! 6. [`Decoder`] rebuilds any frame on its own (Fig. 3.18 on the CPU), into a caller buffer.
+//! 6. [`Decoder`] rebuilds any frame on its own (Fig. 3.18 on the CPU), into a caller buffer;
+//!    with the `gpu` feature (on by default), `GpuDecoder` does the same in a WGSL compute
+//!    shader, into a storage buffer that a renderer binds as its vertex buffer.
 //! 7. [`distortion`] gives d_a and d_f ("Error Measurement"); [`RateParams`] gives
 //!    eqs. 3.16–3.18 and [`bpvf_from_file`] the rate of the actual file.
 //!
@@ -61,6 +63,8 @@
 mod container;
 mod decode;
 pub mod format;
+#[cfg(feature = "gpu")]
+mod gpu;
 mod metrics;
 mod model;
 mod quantize;
@@ -68,6 +72,8 @@ mod quantize;
 pub use container::{Compressed, TimeBasis};
 pub use decode::{DecodeScratch, Decoder};
 pub use format::crc32;
+#[cfg(feature = "gpu")]
+pub use gpu::{GpuDecoder, POSITION_STRIDE};
 pub use metrics::{
     Distortion, EQ_3_16_CONNECTIVITY_BITS, EQ_3_16_INDEX_BITS, RateParams, bpvf_from_file,
     distortion,
