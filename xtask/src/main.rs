@@ -7,11 +7,17 @@
 //!   `depth` and `query` backends on the full bunny and the synthetic cloth — time, rays/s,
 //!   |Δa| against `cpu` and against a level-6 reference — beside the seed's Table 1
 //!   (`target/repro/visibility.md` and `visibility.svg`).
+//! - `cargo xtask repro jumpmap`: jump maps (thesis §3.2.3) on every animation in
+//!   `../shared/data/anim` and the synthetic cloth — Table 3.1 (storage against c), Table 3.2
+//!   (E, E* beside the thesis's), analysis time and playback frames/s, and the σ and q sweeps
+//!   of Figs. 3.8–3.10 as numbers (`target/repro/jumpmap.md`, `jumpmap.svg` and a rendered
+//!   strip of frames per sequence, `jumpmap-<sequence>.png`).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 
 mod compare_clustering;
 mod plot;
+mod repro_jumpmap;
 mod repro_lightsphere;
 mod repro_visibility;
 
@@ -68,6 +74,9 @@ enum Repro {
         #[arg(long, default_value_t = 4)]
         max_level: u32,
     },
+    /// Jump maps (thesis §3.2.3): Tables 3.1 and 3.2, analysis and playback speed, σ and q
+    /// sweeps (Figs. 3.8–3.10 as numbers) and a strip of frames per sequence.
+    Jumpmap,
 }
 
 /// `target/repro` of the workspace.
@@ -85,6 +94,9 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Visibility { quick, max_level },
         } => repro_visibility::run(&repro_dir()?, quick, max_level),
+        Command::Repro {
+            what: Repro::Jumpmap,
+        } => repro_jumpmap::run(&repro_dir()?),
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {

@@ -430,7 +430,8 @@ fn measure_gpu(
 }
 
 /// First "model name" of /proc/cpuinfo, when there is one.
-fn cpu_model() -> Option<String> {
+/// The CPU's model name from `/proc/cpuinfo` (Linux), for reports.
+pub(crate) fn cpu_model() -> Option<String> {
     let info = std::fs::read_to_string("/proc/cpuinfo").ok()?;
     info.lines()
         .find(|l| l.starts_with("model name"))
@@ -438,7 +439,8 @@ fn cpu_model() -> Option<String> {
         .map(|(_, v)| v.trim().to_owned())
 }
 
-fn write_atomic(path: &Path, text: &str) -> anyhow::Result<()> {
+/// Writes a report file atomically (complete or not at all).
+pub(crate) fn write_atomic(path: &Path, text: &str) -> anyhow::Result<()> {
     meshio::write_atomic(path, |w| w.write_all(text.as_bytes()))?;
     Ok(())
 }

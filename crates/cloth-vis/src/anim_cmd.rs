@@ -1,15 +1,42 @@
 //! `cloth-vis anim jumpmap`: endless new animation from a short mesh clip by jump maps
 //! (thesis §3.2, crate `anim-pca`), written as `.npy` [N, V, 3], a `.glb` morph-target
 //! animation or a folder of numbered OBJ frames, with the analysis matrices D, D*, P, P*, P̂
-//! as PNG heat maps (the thesis's Fig. 3.3).
+//! as PNG heat maps (the thesis's Fig. 3.3) and a rendered strip of frames of the new
+//! sequence ([`crate::strip`]).
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anim_pca::{Blend, JumpMap, JumpMapParams, PlaybackParams, Player};
 use glam::Vec3;
+use gpu_context::GpuContext;
 
 use crate::Error;
+use crate::strip::{check_strip, render_strip, write_png};
+
+/// A rendered strip of frames of the generated sequence (`--strip`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StripRequest {
+    /// The `.png` to write.
+    pub path: PathBuf,
+    /// Panels K: frames shown, evenly spaced over the generated run from its first to its
+    /// last frame (default [`crate::strip::DEFAULT_STRIP_FRAMES`]).
+    pub frames: usize,
+    /// Size of one panel in pixels (width, height); the image is K · width × height.
+    pub panel_size: [u32; 2],
+}
+
+impl StripRequest {
+    /// A strip of the default [`crate::strip::DEFAULT_STRIP_FRAMES`] panels of the default
+    /// size into `path`.
+    pub fn new(path: PathBuf) -> Self {
+        Self {
+            path,
+            frames: crate::strip::DEFAULT_STRIP_FRAMES,
+            panel_size: crate::strip::DEFAULT_PANEL_SIZE,
+        }
+    }
+}
 
 /// What `cloth-vis anim jumpmap` was asked to do.
 #[derive(Clone, Debug)]
@@ -27,6 +54,9 @@ pub struct JumpMapRequest {
     /// Folder for the heat maps `D.png`, `D_velocity.png`, `P.png`, `P_velocity.png`,
     /// `P_hat.png` (`None`: none written).
     pub maps: Option<PathBuf>,
+    /// A rendered strip of frames of the generated sequence (`None`: none written; needs a
+    /// GPU adapter, lavapipe is fine).
+    pub strip: Option<StripRequest>,
 }
 
 /// What was generated.
@@ -81,13 +111,17 @@ enum OutKind {
     ObjFolder,
 }
 
-/// Runs the request.
+/// Runs the request. `gpu` is needed only for [`JumpMapRequest::strip`].
 ///
 /// # Errors
 /// Loader errors naming the file; bad parameters (naming the parameter and value), an
-/// unsupported output extension or a zero frame count, refused before any computation; write
-/// errors naming the file.
-pub fn run_jumpmap(request: &JumpMapRequest) -> Result<JumpMapSummary, Error> {
+/// unsupported output extension, a zero frame count, a strip without a GPU adapter or with a
+/// bad panel count or size, refused before any computation; a strip of a clip without
+/// triangles, refused before the analysis; write errors naming the file.
+pub fn run_jumpmap(
+    request: &JumpMapRequest,
+    gpu: Option<&GpuContext>,
+) -> Result<JumpMapSummary, Error> {
     let out = &request.out;
     let kind = match out
         .extension()
@@ -111,7 +145,39 @@ pub fn run_jumpmap(request: &JumpMapRequest) -> Result<JumpMapSummary, Error> {
     if request.frames == 0 {
         return Err(invalid(out, "--frames must be at least 1".to_owned()));
     }
+    let strip_gpu = match &request.strip {
+        None => None,
+        Some(strip) => {
+            let is_png = strip
+                .path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+            if !is_png {
+                return Err(invalid(
+                    &strip.path,
+                    "--strip writes a PNG: give a file name ending in .png".to_owned(),
+                ));
+            }
+            check_strip(request.frames, strip.frames, strip.panel_size, &strip.path)?;
+            let Some(gpu) = gpu else {
+                return Err(invalid(
+                    &strip.path,
+                    "--strip needs a GPU adapter and none was found; a software one is fine \
+                     (Mesa's lavapipe: apt-get install mesa-vulkan-drivers)"
+                        .to_owned(),
+                ));
+            };
+            Some((strip, gpu))
+        }
+    };
     let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
+    if strip_gpu.is_some() && clip.triangles.is_empty() {
+        return Err(invalid(
+            &request.input,
+            "--strip draws triangles and the clip has none (an .npy clip): leave out --strip"
+                .to_owned(),
+        ));
+    }
     let map = JumpMap::analyze(&clip.frames, &request.params)
         .map_err(|e| anim_error(&request.input, e))?;
     let mut player =
@@ -129,6 +195,18 @@ pub fn run_jumpmap(request: &JumpMapRequest) -> Result<JumpMapSummary, Error> {
             .reconstruct(&weights, &mut mesh)
             .map_err(|e| anim_error(&request.input, e))?;
         frames.push(mesh);
+    }
+    if let Some((strip, gpu)) = strip_gpu {
+        let image = render_strip(
+            &gpu.device,
+            &gpu.queue,
+            &frames,
+            &clip.triangles,
+            strip.frames,
+            strip.panel_size,
+            &strip.path,
+        )?;
+        write_png(&strip.path, &image)?;
     }
     match kind {
         OutKind::Npy => {

@@ -45,6 +45,7 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod shadowing;
+pub mod strip;
 pub mod visibility_cmd;
 
 pub use demo::{DEMO_SCENE, demo_scene, run_demo};

@@ -175,6 +175,27 @@ enum AnimCommand {
         /// Folder for the heat maps of D, D*, P, P*, P̂ (PNG).
         #[arg(long)]
         maps: Option<PathBuf>,
+        /// Render evenly spaced frames of the new sequence side by side into FILE.png, one
+        /// camera framing the whole run. Needs a GPU adapter (lavapipe is fine).
+        #[arg(long, value_name = "FILE")]
+        strip: Option<PathBuf>,
+        /// Frames K shown in the --strip (first to last, evenly spaced).
+        #[arg(
+            long,
+            value_name = "K",
+            requires = "strip",
+            default_value_t = cloth_vis::strip::DEFAULT_STRIP_FRAMES
+        )]
+        strip_frames: usize,
+        /// Size of one --strip panel; the image is K·W × H.
+        #[arg(
+            long,
+            value_name = "WxH",
+            requires = "strip",
+            value_parser = parse_size,
+            default_value = "256x256"
+        )]
+        strip_size: [u32; 2],
     },
 }
 
@@ -215,6 +236,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     seed,
                     out,
                     maps,
+                    strip,
+                    strip_frames,
+                    strip_size,
                 },
         } => {
             let request = cloth_vis::anim_cmd::JumpMapRequest {
@@ -237,8 +261,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 frames,
                 out,
                 maps,
+                strip: strip.map(|path| cloth_vis::anim_cmd::StripRequest {
+                    path,
+                    frames: strip_frames,
+                    panel_size: strip_size,
+                }),
             };
-            let summary = cloth_vis::anim_cmd::run_jumpmap(&request)?;
+            // --strip without an adapter is refused by run_jumpmap, naming the flag.
+            let gpu = match request.strip {
+                Some(_) => gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()).ok(),
+                None => None,
+            };
+            let summary = cloth_vis::anim_cmd::run_jumpmap(&request, gpu.as_ref())?;
             writeln!(std::io::stdout().lock(), "{}", summary.line())?;
         }
         Command::Visibility {

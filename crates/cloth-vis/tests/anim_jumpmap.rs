@@ -1,12 +1,13 @@
 //! `cloth-vis anim jumpmap` end to end on a small synthetic clip written as OBJ frames: every
-//! output format, the heat maps, determinism and refused input.
+//! output format, the heat maps, the rendered strip, determinism and refused input.
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anim_pca::{Blend, JumpMapParams, PlaybackParams};
-use cloth_vis::anim_cmd::{JumpMapRequest, run_jumpmap};
+use cloth_vis::anim_cmd::{JumpMapRequest, StripRequest, run_jumpmap};
 use glam::Vec3;
+use gpu_context::{GpuContext, GpuOptions};
 
 const SIDE: usize = 8;
 const PERIOD: f32 = 12.0;
@@ -56,6 +57,7 @@ fn request(input: PathBuf, out: PathBuf) -> JumpMapRequest {
         frames: 200,
         out,
         maps: None,
+        strip: None,
     }
 }
 
@@ -69,7 +71,7 @@ fn npy_output_is_the_clip_replayed_with_jumps_and_deterministic() {
     let dir = tempfile::tempdir().unwrap();
     let clip = write_clip(&dir.path().join("clip"));
     let out = dir.path().join("a.npy");
-    let summary = run_jumpmap(&request(dir.path().join("clip"), out.clone())).unwrap();
+    let summary = run_jumpmap(&request(dir.path().join("clip"), out.clone()), None).unwrap();
     let (shape, data) = read_npy(&out);
     assert_eq!(shape, vec![200, SIDE * SIDE, 3]);
     assert!(data.iter().all(|v| v.is_finite()));
@@ -83,12 +85,12 @@ fn npy_output_is_the_clip_replayed_with_jumps_and_deterministic() {
     assert_eq!(summary.stats.frames, 200);
     // Same seed, same animation; another seed, another one.
     let again = dir.path().join("b.npy");
-    run_jumpmap(&request(dir.path().join("clip"), again.clone())).unwrap();
+    run_jumpmap(&request(dir.path().join("clip"), again.clone()), None).unwrap();
     assert_eq!(read_npy(&again).1, data);
     let other = dir.path().join("c.npy");
     let mut r = request(dir.path().join("clip"), other.clone());
     r.playback.seed = 8;
-    run_jumpmap(&r).unwrap();
+    run_jumpmap(&r, None).unwrap();
     assert_ne!(read_npy(&other).1, data);
 }
 
@@ -99,18 +101,18 @@ fn glb_and_obj_outputs_load_back_as_the_same_frames() {
     let npy = dir.path().join("a.npy");
     let mut r = request(dir.path().join("clip"), npy.clone());
     r.frames = 30;
-    run_jumpmap(&r).unwrap();
+    run_jumpmap(&r, None).unwrap();
     let (_, data) = read_npy(&npy);
 
     let glb = dir.path().join("a.glb");
     r.out = glb.clone();
-    run_jumpmap(&r).unwrap();
+    run_jumpmap(&r, None).unwrap();
     let (anim, _) = meshio::load_animation(&glb, &meshio::AnimationOptions::default()).unwrap();
     assert_eq!(anim.frames.len(), 30);
     assert_eq!(anim.triangles.len(), 2 * (SIDE - 1) * (SIDE - 1));
     let folder = dir.path().join("frames");
     r.out = folder.clone();
-    run_jumpmap(&r).unwrap();
+    run_jumpmap(&r, None).unwrap();
     let (objs, _) = meshio::load_animation(&folder, &meshio::AnimationOptions::default()).unwrap();
     assert_eq!(objs.frames.len(), 30);
     for f in [0, 13, 29] {
@@ -129,7 +131,7 @@ fn heat_maps_are_written_for_all_five_matrices() {
     write_clip(&dir.path().join("clip"));
     let mut r = request(dir.path().join("clip"), dir.path().join("a.npy"));
     r.maps = Some(dir.path().join("maps"));
-    run_jumpmap(&r).unwrap();
+    run_jumpmap(&r, None).unwrap();
     for name in ["D", "D_velocity", "P", "P_velocity", "P_hat"] {
         let image = image::open(dir.path().join("maps").join(format!("{name}.png")))
             .unwrap()
@@ -149,13 +151,13 @@ fn bad_requests_are_refused_before_writing() {
     let dir = tempfile::tempdir().unwrap();
     write_clip(&dir.path().join("clip"));
     let bad_ext = dir.path().join("a.txt");
-    let e = run_jumpmap(&request(dir.path().join("clip"), bad_ext.clone())).unwrap_err();
+    let e = run_jumpmap(&request(dir.path().join("clip"), bad_ext.clone()), None).unwrap_err();
     assert!(e.to_string().contains(".txt"), "{e}");
     assert!(!bad_ext.exists());
     let out = dir.path().join("a.npy");
     let mut r = request(dir.path().join("clip"), out.clone());
     r.params.sigma = -1.0;
-    let e = run_jumpmap(&r).unwrap_err();
+    let e = run_jumpmap(&r, None).unwrap_err();
     assert!(
         e.to_string().contains("sigma") || e.to_string().contains("σ"),
         "{e}"
@@ -163,7 +165,119 @@ fn bad_requests_are_refused_before_writing() {
     assert!(!out.exists());
     let mut r = request(dir.path().join("missing"), out.clone());
     r.frames = 10;
-    let e = run_jumpmap(&r).unwrap_err();
+    let e = run_jumpmap(&r, None).unwrap_err();
     assert!(e.to_string().contains("missing"), "{e}");
     assert!(!out.exists());
+}
+
+/// A GPU context, or `None` after the project's skip policy (fails under CI). Lavapipe wants
+/// `XDG_RUNTIME_DIR` set (e.g. `/tmp`) in the test's environment.
+fn gpu() -> Option<GpuContext> {
+    match GpuContext::new(&GpuOptions::default()) {
+        Ok(g) => Some(g),
+        Err(e) => test_data::skip(&format!("no GPU adapter: {e}")),
+    }
+}
+
+/// Mean absolute difference of two equally sized RGB panels, in 8-bit steps.
+fn panel_difference(a: &[[u8; 3]], b: &[[u8; 3]]) -> f64 {
+    let sum: u64 = a
+        .iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..3).map(move |k| u64::from(p[k].abs_diff(q[k]))))
+        .sum();
+    sum as f64 / (3 * a.len()) as f64
+}
+
+#[test]
+fn strip_shows_k_shaded_frames_of_the_run_side_by_side() {
+    let Some(gpu) = gpu() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(&dir.path().join("clip"));
+    let png = dir.path().join("strip.png");
+    let (k, w, h) = (5usize, 96u32, 64u32);
+    let mut r = request(dir.path().join("clip"), dir.path().join("a.npy"));
+    r.strip = Some(StripRequest {
+        path: png.clone(),
+        frames: k,
+        panel_size: [w, h],
+    });
+    run_jumpmap(&r, Some(&gpu)).unwrap();
+    let image = image::open(&png).unwrap().to_rgb8();
+    assert_eq!(image.dimensions(), (k as u32 * w, h));
+    let panels: Vec<Vec<[u8; 3]>> = (0..k as u32)
+        .map(|p| {
+            (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| image.get_pixel(p * w + x, y).0)
+                .collect()
+        })
+        .collect();
+    for (p, panel) in panels.iter().enumerate() {
+        // Not blank: the grid covers a good part of each panel (the background is black) …
+        let covered = panel.iter().filter(|px| px.iter().any(|c| *c > 0)).count();
+        assert!(
+            covered as f64 > 0.1 * panel.len() as f64,
+            "panel {p}: {covered} of {} pixels drawn",
+            panel.len()
+        );
+        // … and it is shaded, not a flat silhouette.
+        let mut levels: Vec<u8> = panel.iter().map(|px| px[1]).filter(|g| *g > 0).collect();
+        levels.sort_unstable();
+        levels.dedup();
+        assert!(levels.len() > 8, "panel {p}: grey levels {levels:?}");
+    }
+    // The run moves, so its frames differ: every panel differs from the first one's pose
+    // somewhere, and not all of them only a little.
+    let differences: Vec<f64> = panels[1..]
+        .iter()
+        .map(|p| panel_difference(&panels[0], p))
+        .collect();
+    assert!(
+        differences.iter().copied().fold(0.0, f64::max) > 2.0,
+        "panels barely differ: {differences:?}"
+    );
+    // Same frames, same camera: rendering the run again gives the same strip.
+    let again = dir.path().join("again.png");
+    r.strip.as_mut().unwrap().path = again.clone();
+    run_jumpmap(&r, Some(&gpu)).unwrap();
+    let second = image::open(&again).unwrap().to_rgb8();
+    let drift = panel_difference(
+        &image.pixels().map(|p| p.0).collect::<Vec<_>>(),
+        &second.pixels().map(|p| p.0).collect::<Vec<_>>(),
+    );
+    assert!(drift < 0.5, "re-render differs by {drift}");
+}
+
+#[test]
+fn bad_strips_are_refused_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(&dir.path().join("clip"));
+    let out = dir.path().join("a.npy");
+    let png = dir.path().join("s.png");
+    let mut r = request(dir.path().join("clip"), out.clone());
+    // Without an adapter, naming the flag.
+    r.strip = Some(StripRequest::new(png.clone()));
+    let e = run_jumpmap(&r, None).unwrap_err();
+    assert!(e.to_string().contains("--strip"), "{e}");
+    assert!(e.to_string().contains("s.png"), "{e}");
+    // More panels than frames, or none.
+    for k in [0, 201] {
+        r.strip = Some(StripRequest {
+            frames: k,
+            ..StripRequest::new(png.clone())
+        });
+        let e = run_jumpmap(&r, None).unwrap_err();
+        assert!(
+            e.to_string().contains(&format!("--strip-frames {k}")),
+            "{e}"
+        );
+    }
+    // Not a PNG.
+    r.strip = Some(StripRequest::new(dir.path().join("s.jpg")));
+    let e = run_jumpmap(&r, None).unwrap_err();
+    assert!(e.to_string().contains("s.jpg"), "{e}");
+    assert!(!out.exists() && !png.exists());
 }

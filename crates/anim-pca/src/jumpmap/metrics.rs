@@ -194,10 +194,14 @@ pub fn max_velocity_change(
 }
 
 /// The clip's own largest per-vertex frame-to-frame velocity change, on the reconstructed key
-/// frames 0 … l−1 (the reference for [`transition_velocity_change`]).
+/// frames 0 … l−1 of every cell (the reference for [`transition_velocity_change`]).
 pub fn clip_max_velocity_change(map: &JumpMap) -> f64 {
-    let keys: Vec<GeneratedFrame> = (0..map.n_frames()).map(GeneratedFrame::key).collect();
-    max_velocity_change(map, &keys, 0..keys.len())
+    (0..map.n_cells())
+        .map(|cell| {
+            let keys: Vec<GeneratedFrame> = map.cell_range(cell).map(GeneratedFrame::key).collect();
+            max_velocity_change(map, &keys, 0..keys.len())
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The largest per-vertex velocity change over all transitions of `generated`: for each, the
@@ -214,4 +218,289 @@ pub fn transition_velocity_change(map: &JumpMap, generated: &Generated) -> f64 {
             )
         })
         .fold(0.0, f64::max)
+}
+
+/// Bytes of one stored float: frames, eigenframes and weights are all counted as f32 (the
+/// weights are f64 inside [`JumpMap`], but f32 is what a compressed file or a GPU buffer would
+/// hold, and the frames themselves come in as f32).
+pub const BYTES_PER_FLOAT: u64 = 4;
+
+/// What one frame vector A_i holds, for [`compression_ratio`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FrameContents {
+    /// Positions only, 3N floats: the frame vectors of [`JumpMap::analyze`].
+    Positions,
+    /// Positions and normals, 6N floats: the frame vectors of
+    /// [`JumpMap::analyze_with_normals`] and of the thesis (§3.2.2: "the vertex normals are
+    /// also included in the vectors A_i").
+    PositionsAndNormals,
+}
+
+impl FrameContents {
+    /// Floats per vertex in A_i (3 or 6).
+    pub fn floats_per_vertex(self) -> u64 {
+        match self {
+            Self::Positions => 3,
+            Self::PositionsAndNormals => 6,
+        }
+    }
+}
+
+/// Storage of a clip and of its PCA representation with c components: one row of the thesis's
+/// Table 3.1 (see [`compression_ratio`] for what is counted).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Compression {
+    /// Components c (0 = the mean frame only).
+    pub components: usize,
+    /// What each frame vector holds.
+    pub contents: FrameContents,
+    /// The raw clip: l · N · (3 or 6) f32.
+    pub raw_bytes: u64,
+    /// The PCA representation: (1 + c) · N · (3 or 6) f32 for the mean and the eigenframes,
+    /// plus l · c f32 weights.
+    pub pca_bytes: u64,
+}
+
+impl Compression {
+    /// r of the ratio 1:r, raw over PCA bytes (the thesis prints 1:15 for r = 15).
+    pub fn ratio(&self) -> f64 {
+        self.raw_bytes as f64 / self.pca_bytes as f64
+    }
+
+    /// The raw clip in MB (10⁶ bytes; the thesis does not say which megabyte it uses).
+    pub fn raw_megabytes(&self) -> f64 {
+        self.raw_bytes as f64 / 1e6
+    }
+
+    /// The PCA representation in MB (10⁶ bytes).
+    pub fn pca_megabytes(&self) -> f64 {
+        self.pca_bytes as f64 / 1e6
+    }
+}
+
+/// Compression of a clip of `frames` frames of `vertices` vertices by a PCA with `components`
+/// eigenframes (the thesis's Table 3.1, "PCA Compression Ratio", §3.2.3).
+///
+/// Counted, all as f32 ([`BYTES_PER_FLOAT`]):
+/// * raw: l · N · k floats, k = 3 for positions, 6 for positions and normals
+///   ([`FrameContents`]);
+/// * PCA: the mean frame F_0 and c eigenframes F_1 … F_c of N · k floats each (eq. 3.1), and
+///   l · c weights.
+///
+/// Not counted, in either: the connectivity and texture coordinates (the same in both, and
+/// the thesis's conclusion lists them separately), the velocity PCA and the jump map (needed
+/// for playback, not for reconstruction), any file header.
+///
+/// The thesis's Table 3.1 does not say what it counts. Its A_i hold positions and normals,
+/// so [`FrameContents::PositionsAndNormals`] is the like-for-like row. Its figures do not
+/// follow from a fixed cost per eigenframe: one avatar frame is 138 MB / 115 = 1.2 MB, so
+/// c = 1 … 10 should add 9 · 1.2 = 10.8 MB, yet the column grows by 6.6 MB (and by 0.6 MB
+/// from c = 2 to 4). Only the order of magnitude of its ratios can be compared.
+///
+/// # Errors
+/// [`AnimPcaError::EmptyClip`](crate::AnimPcaError::EmptyClip) for no frames or no vertices;
+/// [`AnimPcaError::InvalidParameter`](crate::AnimPcaError::InvalidParameter) when c exceeds
+/// what a PCA of the clip can have (l − 1 components after centring, and at most the N · k
+/// dimensions of A_i), or when the byte counts overflow u64.
+///
+/// # Examples
+/// ```
+/// use anim_pca::jumpmap::metrics::{FrameContents, compression_ratio};
+/// // 100 frames of 1,000 vertices, positions only, c = 4:
+/// // raw 100·1000·3·4 B = 1.2 MB; PCA (1 + 4)·1000·3·4 + 100·4·4 B = 61,600 B.
+/// let row = compression_ratio(100, 1000, 4, FrameContents::Positions).unwrap();
+/// assert_eq!((row.raw_bytes, row.pca_bytes), (1_200_000, 61_600));
+/// assert!((row.ratio() - 19.48).abs() < 0.01);
+/// ```
+pub fn compression_ratio(
+    frames: usize,
+    vertices: usize,
+    components: usize,
+    contents: FrameContents,
+) -> Result<Compression> {
+    const WHAT: &str = "compression_ratio";
+    if frames == 0 || vertices == 0 {
+        return Err(crate::AnimPcaError::EmptyClip {
+            what: WHAT,
+            frames,
+            vertices,
+        });
+    }
+    let overflow = || {
+        crate::error::invalid(
+            WHAT,
+            "vertices",
+            vertices,
+            "the clip's size in bytes overflows u64",
+        )
+    };
+    let (l, n, c) = (frames as u64, vertices as u64, components as u64);
+    let frame_floats = n
+        .checked_mul(contents.floats_per_vertex())
+        .ok_or_else(overflow)?;
+    if c > l - 1 || c > frame_floats {
+        return Err(crate::error::invalid(
+            WHAT,
+            "components",
+            components,
+            "c must be ≤ l − 1 and ≤ the floats per frame: a PCA of l frames has at most \
+             l − 1 components",
+        ));
+    }
+    let bytes = |floats: Option<u64>| {
+        floats
+            .and_then(|f| f.checked_mul(BYTES_PER_FLOAT))
+            .ok_or_else(overflow)
+    };
+    let raw_bytes = bytes(l.checked_mul(frame_floats))?;
+    let pca_bytes = bytes(
+        (c + 1)
+            .checked_mul(frame_floats)
+            .and_then(|f| f.checked_add(l * c)),
+    )?;
+    Ok(Compression {
+        components,
+        contents,
+        raw_bytes,
+        pca_bytes,
+    })
+}
+
+/// [`compression_ratio`] of an analysed clip with the components it kept
+/// ([`JumpMap::components`]), counting normals when it was analysed with them.
+///
+/// # Panics
+/// Never for a map built by [`JumpMap::analyze`] or [`JumpMap::analyze_with_normals`].
+pub fn map_compression(map: &JumpMap) -> Compression {
+    let contents = if map.reconstructor().has_normals() {
+        FrameContents::PositionsAndNormals
+    } else {
+        FrameContents::Positions
+    };
+    // A map's clip has ≥ 2 frames and ≥ 1 vertex, it kept c ≤ l − 1 components, and its
+    // frames were held in memory, so their byte count fits in u64: an error is a bug here.
+    compression_ratio(map.n_frames(), map.n_vertices(), map.components(), contents)
+        .expect("an analysed clip is non-empty, has c ≤ l − 1 and fits in memory")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{AnimPcaError, JumpMapParams};
+
+    #[test]
+    fn compression_matches_a_hand_count() {
+        // 100 frames × 1,000 vertices × 3 floats × 4 B = 1,200,000 B; c = 4: the mean and four
+        // eigenframes of 3,000 floats (60,000 B) and 100 × 4 weights (1,600 B).
+        let row = compression_ratio(100, 1000, 4, FrameContents::Positions).unwrap();
+        assert_eq!((row.raw_bytes, row.pca_bytes), (1_200_000, 61_600));
+        assert!((row.ratio() - 1_200_000.0 / 61_600.0).abs() < 1e-12);
+        assert!((row.raw_megabytes() - 1.2).abs() < 1e-12);
+        // Normals double the frame vector but not the weights: 2,400,000 B against
+        // 5 × 6,000 × 4 + 1,600 = 121,600 B.
+        let row = compression_ratio(100, 1000, 4, FrameContents::PositionsAndNormals).unwrap();
+        assert_eq!((row.raw_bytes, row.pca_bytes), (2_400_000, 121_600));
+        // c = 0 keeps only the mean frame: the ratio is l.
+        let row = compression_ratio(100, 1000, 0, FrameContents::Positions).unwrap();
+        assert_eq!(row.pca_bytes, 12_000);
+        assert_eq!(row.ratio(), 100.0);
+    }
+
+    #[test]
+    fn each_component_costs_one_frame_plus_a_weight_per_frame_and_lowers_the_ratio() {
+        for (l, n) in [(25, 8431), (170, 3030), (2, 1), (40, 7)] {
+            for contents in [FrameContents::Positions, FrameContents::PositionsAndNormals] {
+                let k = contents.floats_per_vertex();
+                let rows: Vec<Compression> = (0..l)
+                    .map(|c| compression_ratio(l, n, c, contents))
+                    .take_while(|r| r.is_ok())
+                    .map(Result::unwrap)
+                    .collect();
+                assert_eq!(rows.len(), l.min(n * k as usize + 1), "l = {l}, N = {n}");
+                for w in rows.windows(2) {
+                    assert_eq!(
+                        w[1].pca_bytes - w[0].pca_bytes,
+                        (n as u64 * k + l as u64) * BYTES_PER_FLOAT
+                    );
+                    assert_eq!(w[1].raw_bytes, w[0].raw_bytes);
+                    assert!(w[1].ratio() < w[0].ratio(), "l = {l}, N = {n}: {w:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn compression_refuses_an_empty_clip_and_more_components_than_frames() {
+        assert!(matches!(
+            compression_ratio(0, 10, 0, FrameContents::Positions),
+            Err(AnimPcaError::EmptyClip { frames: 0, .. })
+        ));
+        assert!(matches!(
+            compression_ratio(10, 0, 0, FrameContents::Positions),
+            Err(AnimPcaError::EmptyClip { vertices: 0, .. })
+        ));
+        let e = compression_ratio(10, 100, 10, FrameContents::Positions).unwrap_err();
+        assert!(e.to_string().contains("components"), "{e}");
+        assert!(e.to_string().contains("10"), "{e}");
+        let e = compression_ratio(usize::MAX, usize::MAX, 1, FrameContents::Positions);
+        assert!(e.unwrap_err().to_string().contains("overflow"));
+    }
+
+    /// A 6 × 6 grid waving with a 9-frame period, 30 frames.
+    fn wave() -> Vec<Vec<Vec3>> {
+        (0..30)
+            .map(|t| {
+                let ph = t as f32 / 9.0 * std::f32::consts::TAU;
+                (0..36)
+                    .map(|n| {
+                        let (x, y) = ((n % 6) as f32, (n / 6) as f32);
+                        Vec3::new(x, y, (ph + 0.5 * x).sin() + 0.3 * (2.0 * ph + y).cos())
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn map_compression_counts_the_arrays_the_map_holds() {
+        let clip = wave();
+        let normals: Vec<Vec<Vec3>> = clip
+            .iter()
+            .map(|f| {
+                f.iter()
+                    .map(|p| Vec3::new(p.z, 0.3, 1.0).normalize())
+                    .collect()
+            })
+            .collect();
+        let params = JumpMapParams {
+            components: 3,
+            ..JumpMapParams::default()
+        };
+        for (map, contents) in [
+            (
+                JumpMap::analyze(&clip, &params).unwrap(),
+                FrameContents::Positions,
+            ),
+            (
+                JumpMap::analyze_with_normals(&clip, &normals, &params).unwrap(),
+                FrameContents::PositionsAndNormals,
+            ),
+        ] {
+            let row = map_compression(&map);
+            assert_eq!(row.contents, contents);
+            assert_eq!(row.components, 3);
+            // Raw: the clip's own f32 storage (normals are as large as positions).
+            let per_frame = 36 * std::mem::size_of::<Vec3>() as u64;
+            let raw = 30 * per_frame * contents.floats_per_vertex() / 3;
+            assert_eq!(row.raw_bytes, raw);
+            // PCA: the mean and c eigenframes the map's PCA holds, and its l × c weights, as f32.
+            let pca = map.pca();
+            let floats = pca.mean().len()
+                + (0..map.components())
+                    .map(|k| pca.component(k).len())
+                    .sum::<usize>()
+                + map.n_frames() * map.weights(0).len();
+            assert_eq!(row.pca_bytes, floats as u64 * BYTES_PER_FLOAT);
+        }
+    }
 }
