@@ -7,7 +7,7 @@
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
-use anim_pca::{Blend, JumpMap, JumpMapParams, PlaybackParams, Player};
+use anim_pca::{Blend, Clip, JumpMap, JumpMapParams, LoopTable, PlaybackParams, Player};
 use glam::Vec3;
 use gpu_context::GpuContext;
 
@@ -38,13 +38,30 @@ impl StripRequest {
     }
 }
 
+/// How the generated run is steered beyond random play: cells and motion control
+/// (thesis §3.2.2 "Motion Control") or a fixed-length loop (Fig. 3.2's loop table).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlayControl {
+    /// Further clips, analysed with the input as cells 1, 2, … (the input is cell 0); they must
+    /// have the input's vertex count.
+    pub cells: Vec<PathBuf>,
+    /// (generated frame, cell): from that frame on, move into that cell at the best transition
+    /// ahead ([`Player::set_target_cell`]). Applied in frame order.
+    pub cell_at: Vec<(usize, usize)>,
+    /// Play the cheapest loop of exactly this many frames ([`LoopTable`]) instead of random
+    /// play; the output repeats it to `frames`.
+    pub loop_length: Option<usize>,
+}
+
 /// What `cloth-vis anim jumpmap` was asked to do.
 #[derive(Clone, Debug)]
 pub struct JumpMapRequest {
     /// The clip: a folder of numbered OBJ frames, `.npy` [F, V, 3] or an animated glTF.
     pub input: PathBuf,
-    /// Analysis parameters (c, c*, σ, σ*, q, q*).
+    /// Analysis parameters (c, c*, σ, σ*, q, q*, root motion).
     pub params: JumpMapParams,
+    /// Cells, a cell schedule or a loop length.
+    pub control: PlayControl,
     /// Playback parameters (memory m, blending, seed).
     pub playback: PlaybackParams,
     /// Frames to generate.
@@ -178,22 +195,110 @@ pub fn run_jumpmap(
                 .to_owned(),
         ));
     }
-    let map = JumpMap::analyze(&clip.frames, &request.params)
+    let control = &request.control;
+    if control.loop_length.is_some() && !control.cell_at.is_empty() {
+        return Err(invalid(
+            &request.input,
+            "--loop plays one fixed loop and --cell-at steers random play: give one of them"
+                .to_owned(),
+        ));
+    }
+    let mut cells = Vec::with_capacity(control.cells.len());
+    for path in &control.cells {
+        let (cell, _) = meshio::load_animation(path, &meshio::AnimationOptions::default())?;
+        let (found, expected) = (cell.frames[0].len(), clip.frames[0].len());
+        if found != expected {
+            return Err(invalid(
+                path,
+                format!(
+                    "--cell clip has {found} vertices but {} has {expected}; cells share one mesh",
+                    request.input.display()
+                ),
+            ));
+        }
+        cells.push(cell);
+    }
+    let clips: Vec<Clip<'_>> = std::iter::once(&clip)
+        .chain(&cells)
+        .map(|c| Clip::new(&c.frames))
+        .collect();
+    for &(at, cell) in &control.cell_at {
+        if cell >= clips.len() {
+            return Err(invalid(
+                &request.input,
+                format!(
+                    "--cell-at {at}:{cell} names cell {cell} but there are {} cell(s) (the \
+                     input is cell 0, each --cell adds one)",
+                    clips.len()
+                ),
+            ));
+        }
+    }
+    let map = JumpMap::analyze_cells(&clips, &request.params)
         .map_err(|e| anim_error(&request.input, e))?;
-    let mut player =
-        Player::new(&map, &request.playback).map_err(|e| anim_error(&request.input, e))?;
-    let generated = player.generate(request.frames);
+    let generated = match control.loop_length {
+        Some(n) => {
+            let cell = map.cell_of(request.playback.start_frame.min(map.n_frames() - 1));
+            let table = LoopTable::build(&map, cell, n, request.playback.blend)
+                .map_err(|e| anim_error(&request.input, e))?;
+            let Some(found) = table.get(n) else {
+                let near: Vec<String> = table
+                    .iter()
+                    .map(|l| l.len())
+                    .filter(|&m| m + 10 >= n)
+                    .map(|m| m.to_string())
+                    .collect();
+                return Err(invalid(
+                    &request.input,
+                    format!(
+                        "--loop {n}: the clip has no loop of exactly {n} frames; nearest \
+                         lengths below: {}",
+                        if near.is_empty() {
+                            "none".to_owned()
+                        } else {
+                            near.join(", ")
+                        }
+                    ),
+                ));
+            };
+            found.play(request.frames)
+        }
+        None => {
+            let mut player =
+                Player::new(&map, &request.playback).map_err(|e| anim_error(&request.input, e))?;
+            let mut schedule = control.cell_at.clone();
+            schedule.sort_by_key(|&(at, _)| at);
+            let mut generated = anim_pca::Generated::default();
+            for (at, cell) in schedule {
+                let upto = at.min(request.frames);
+                let part = player.generate(upto.saturating_sub(generated.frames.len()));
+                generated.frames.extend(part.frames);
+                generated.transitions.extend(part.transitions);
+                player
+                    .set_target_cell(cell)
+                    .map_err(|e| anim_error(&request.input, e))?;
+            }
+            let rest = player.generate(request.frames - generated.frames.len());
+            generated.frames.extend(rest.frames);
+            generated.transitions.extend(rest.transitions);
+            generated
+        }
+    };
     let stats = anim_pca::jumpmap::metrics::sequence_stats(&map, &generated);
+    let offsets = map.root_offsets(&generated.frames);
 
     let vertices = map.n_vertices();
     let mut weights = vec![0.0; map.components()];
     let mut frames = Vec::with_capacity(request.frames);
-    for frame in &generated.frames {
+    for (frame, offset) in generated.frames.iter().zip(&offsets) {
         frame.weights_into(&map, &mut weights);
         let mut mesh = vec![Vec3::ZERO; vertices];
         map.reconstructor()
             .reconstruct(&weights, &mut mesh)
             .map_err(|e| anim_error(&request.input, e))?;
+        for v in &mut mesh {
+            *v += *offset;
+        }
         frames.push(mesh);
     }
     if let Some((strip, gpu)) = strip_gpu {
@@ -341,6 +446,21 @@ fn write_heat_map(path: &Path, matrix: &anim_pca::SquareMatrix, log: bool) -> Re
         })?;
     meshio::write_atomic(path, |w| w.write_all(&png))?;
     Ok(())
+}
+
+/// Parses `--cell-at FRAME:CELL`.
+///
+/// # Errors
+/// A message naming the text when it is not two unsigned integers joined by `:`.
+pub fn parse_cell_at(text: &str) -> Result<(usize, usize), String> {
+    let parse = |part: Option<&str>| part.and_then(|p| p.trim().parse::<usize>().ok());
+    let mut parts = text.splitn(2, ':');
+    match (parse(parts.next()), parse(parts.next())) {
+        (Some(frame), Some(cell)) => Ok((frame, cell)),
+        _ => Err(format!(
+            "`{text}` is not FRAME:CELL (e.g. 300:1 moves into cell 1 from generated frame 300)"
+        )),
+    }
 }
 
 /// Playback blending from the CLI's `--blend B` / `--smoothness S` (at most one; neither:

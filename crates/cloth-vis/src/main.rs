@@ -136,6 +136,22 @@ enum AnimCommand {
     Jumpmap {
         /// The clip: a folder of numbered .obj frames, .npy [F, V, 3] or an animated .glb.
         input: PathBuf,
+        /// A further clip of the same mesh, analysed as the next cell (motion control,
+        /// thesis §3.2.2); repeat for more cells. The input is cell 0.
+        #[arg(long, value_name = "CLIP")]
+        cell: Vec<PathBuf>,
+        /// From generated frame FRAME on, move into cell CELL at the best transition ahead;
+        /// repeat to script a route (e.g. --cell-at 200:1 --cell-at 500:0).
+        #[arg(long, value_name = "FRAME:CELL", value_parser = cloth_vis::anim_cmd::parse_cell_at)]
+        cell_at: Vec<(usize, usize)>,
+        /// Play the cheapest loop of exactly N frames (blend frames included), repeated,
+        /// instead of random play.
+        #[arg(long = "loop", value_name = "N", conflicts_with = "cell_at")]
+        loop_length: Option<usize>,
+        /// Take the clip's travel out before the analysis and replay it by integration (for
+        /// clips that walk across the scene).
+        #[arg(long)]
+        root_motion: bool,
         /// c: PCA components of the frames.
         #[arg(long, default_value_t = 10)]
         components: usize,
@@ -197,6 +213,50 @@ enum AnimCommand {
         )]
         strip_size: [u32; 2],
     },
+    /// Compress a clip by clustered PCA (thesis §3.3.2) into a .cpca file; prints V, F, k, c,
+    /// c*, bits, file size, bpvf, d_a, the worst d_f and the encode time.
+    Compress {
+        /// The clip: a folder of numbered .obj frames, .npy [F, V, 3] or an animated .glb.
+        input: PathBuf,
+        /// k: vertex clusters (clamped to V).
+        #[arg(long, default_value_t = anim_pca::compress::CpcaParams::default().clusters)]
+        clusters: usize,
+        /// c: eigentrajectories per cluster (clamped to 3F).
+        #[arg(long, default_value_t = anim_pca::compress::CpcaParams::default().components)]
+        components: usize,
+        /// c*: components of the second PCA along time (default: none).
+        #[arg(long, value_name = "C*")]
+        time_components: Option<usize>,
+        /// q_c: bits of the means and eigentrajectories, 1..=32.
+        #[arg(long, value_name = "BITS", default_value_t = anim_pca::compress::DEFAULT_BITS)]
+        qc: u8,
+        /// q_w: bits of the weights, 1..=32.
+        #[arg(long, value_name = "BITS", default_value_t = anim_pca::compress::DEFAULT_BITS)]
+        qw: u8,
+        /// Seed of the local PCA (same seed, same file).
+        #[arg(long, default_value_t = 0)]
+        seed: u64,
+        /// Output: FILE.cpca.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Decode every frame of a .cpca file into .npy [F, V, 3], a .glb morph-target animation
+    /// or a folder of OBJ frames (with the triangles stored in the file).
+    Decompress {
+        /// The .cpca file.
+        input: PathBuf,
+        /// Output: FILE.npy, FILE.glb or a folder name (OBJ frames).
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Compare a .cpca file with its original clip: bpvf (eqs. 3.16–3.18 and file size), d_a
+    /// and the worst d_f.
+    Stats {
+        /// The original clip (folder of .obj frames, .npy or .glb).
+        original: PathBuf,
+        /// The .cpca file.
+        cpca: PathBuf,
+    },
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -223,6 +283,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             command:
                 AnimCommand::Jumpmap {
                     input,
+                    cell,
+                    cell_at,
+                    loop_length,
+                    root_motion,
                     components,
                     velocity_components,
                     sigma,
@@ -250,7 +314,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     sigma_velocity: sigma_v,
                     q,
                     q_velocity: qv,
+                    root_motion: if root_motion {
+                        anim_pca::RootMotion::Extract
+                    } else {
+                        anim_pca::RootMotion::Keep
+                    },
                     ..Default::default()
+                },
+                control: cloth_vis::anim_cmd::PlayControl {
+                    cells: cell,
+                    cell_at,
+                    loop_length,
                 },
                 playback: anim_pca::PlaybackParams {
                     memory,
@@ -273,6 +347,48 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 None => None,
             };
             let summary = cloth_vis::anim_cmd::run_jumpmap(&request, gpu.as_ref())?;
+            writeln!(std::io::stdout().lock(), "{}", summary.line())?;
+        }
+        Command::Anim {
+            command:
+                AnimCommand::Compress {
+                    input,
+                    clusters,
+                    components,
+                    time_components,
+                    qc,
+                    qw,
+                    seed,
+                    out,
+                },
+        } => {
+            let request = cloth_vis::anim_compress_cmd::CompressRequest {
+                input,
+                params: anim_pca::compress::CpcaParams {
+                    clusters,
+                    components,
+                    time_components,
+                    bits_components: qc,
+                    bits_weights: qw,
+                    seed,
+                    ..Default::default()
+                },
+                out,
+            };
+            let summary = cloth_vis::anim_compress_cmd::run_compress(&request)?;
+            writeln!(std::io::stdout().lock(), "{}", summary.line())?;
+        }
+        Command::Anim {
+            command: AnimCommand::Decompress { input, out },
+        } => {
+            let request = cloth_vis::anim_compress_cmd::DecompressRequest { input, out };
+            let summary = cloth_vis::anim_compress_cmd::run_decompress(&request)?;
+            writeln!(std::io::stdout().lock(), "{}", summary.line())?;
+        }
+        Command::Anim {
+            command: AnimCommand::Stats { original, cpca },
+        } => {
+            let summary = cloth_vis::anim_compress_cmd::run_stats(&original, &cpca)?;
             writeln!(std::io::stdout().lock(), "{}", summary.line())?;
         }
         Command::Visibility {

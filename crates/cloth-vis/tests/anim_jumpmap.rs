@@ -5,7 +5,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anim_pca::{Blend, JumpMapParams, PlaybackParams};
-use cloth_vis::anim_cmd::{JumpMapRequest, StripRequest, run_jumpmap};
+use cloth_vis::anim_cmd::{JumpMapRequest, PlayControl, StripRequest, parse_cell_at, run_jumpmap};
 use glam::Vec3;
 use gpu_context::{GpuContext, GpuOptions};
 
@@ -15,6 +15,12 @@ const CLIP_FRAMES: usize = 40;
 
 /// A waving 8 × 8 grid, period 12 frames, as numbered OBJ frames `1.obj` … in `dir`.
 fn write_clip(dir: &Path) -> Vec<Vec<Vec3>> {
+    write_clip_scaled(dir, 1.0, Vec3::ZERO)
+}
+
+/// [`write_clip`] with the wave's height scaled by `amplitude` and frame t moved by
+/// `t · travel`.
+fn write_clip_scaled(dir: &Path, amplitude: f32, travel: Vec3) -> Vec<Vec<Vec3>> {
     std::fs::create_dir_all(dir).unwrap();
     let mut frames = Vec::new();
     for t in 0..CLIP_FRAMES {
@@ -25,8 +31,8 @@ fn write_clip(dir: &Path) -> Vec<Vec<Vec3>> {
                 Vec3::new(
                     x,
                     y,
-                    (phase + 0.6 * x).sin() + 0.3 * (2.0 * phase + 0.4 * y).cos(),
-                )
+                    amplitude * ((phase + 0.6 * x).sin() + 0.3 * (2.0 * phase + 0.4 * y).cos()),
+                ) + travel * t as f32
             })
             .collect();
         let mut file = std::fs::File::create(dir.join(format!("{}.obj", t + 1))).unwrap();
@@ -49,6 +55,7 @@ fn request(input: PathBuf, out: PathBuf) -> JumpMapRequest {
     JumpMapRequest {
         input,
         params: JumpMapParams::default(),
+        control: PlayControl::default(),
         playback: PlaybackParams {
             blend: Blend::Fixed(3),
             seed: 7,
@@ -280,4 +287,86 @@ fn bad_strips_are_refused_before_writing() {
     let e = run_jumpmap(&r, None).unwrap_err();
     assert!(e.to_string().contains("s.jpg"), "{e}");
     assert!(!out.exists() && !png.exists());
+}
+
+#[test]
+fn loop_output_repeats_with_the_requested_period() {
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(&dir.path().join("clip"));
+    let out = dir.path().join("loop.npy");
+    let mut req = request(dir.path().join("clip"), out.clone());
+    req.control.loop_length = Some(24);
+    req.frames = 100;
+    let summary = run_jumpmap(&req, None).unwrap();
+    assert!(summary.stats.transitions >= 4, "{summary:?}");
+    let (shape, data) = read_npy(&out);
+    assert_eq!(shape, vec![100, SIDE * SIDE, 3]);
+    let frame = |t: usize| &data[t * SIDE * SIDE * 3..(t + 1) * SIDE * SIDE * 3];
+    for t in 0..100 - 24 {
+        assert_eq!(frame(t), frame(t + 24), "frame {t}");
+    }
+    // A length with no loop is refused, naming the lengths that exist.
+    req.control.loop_length = Some(1);
+    let err = run_jumpmap(&req, None).unwrap_err().to_string();
+    assert!(err.contains("max_len"), "{err}");
+}
+
+#[test]
+fn cells_switch_where_the_schedule_says() {
+    let dir = tempfile::tempdir().unwrap();
+    write_clip(&dir.path().join("calm"));
+    write_clip_scaled(&dir.path().join("wild"), 2.0, Vec3::ZERO);
+    let out = dir.path().join("cells.npy");
+    let mut req = request(dir.path().join("calm"), out.clone());
+    req.control.cells = vec![dir.path().join("wild")];
+    req.control.cell_at = vec![(100, 1)];
+    req.frames = 300;
+    run_jumpmap(&req, None).unwrap();
+    let (_, data) = read_npy(&out);
+    let height = |t: usize| {
+        data[t * SIDE * SIDE * 3..(t + 1) * SIDE * SIDE * 3]
+            .chunks(3)
+            .map(|p| p[2].abs())
+            .fold(0.0f32, f32::max)
+    };
+    // Calm (|z| ≤ 1.3) before the switch, wild (|z| up to 2.6) once the horizon and the blend
+    // have passed.
+    assert!((0..100).all(|t| height(t) < 1.35));
+    let late = (100 + 30 + 4..300).map(height).fold(0.0f32, f32::max);
+    assert!(
+        late > 2.0,
+        "after the switch the wild cell plays: max |z| {late}"
+    );
+    // A schedule naming a missing cell, or a cell with another mesh, is refused.
+    req.control.cell_at = vec![(100, 2)];
+    let err = run_jumpmap(&req, None).unwrap_err().to_string();
+    assert!(err.contains("cell 2") && err.contains("2 cell(s)"), "{err}");
+    assert!(parse_cell_at("100:x").is_err());
+    assert_eq!(parse_cell_at("100:1"), Ok((100, 1)));
+}
+
+#[test]
+fn root_motion_keeps_a_walking_clip_walking() {
+    let dir = tempfile::tempdir().unwrap();
+    let step = Vec3::new(0.25, 0.0, 0.0);
+    write_clip_scaled(&dir.path().join("walk"), 1.0, step);
+    let out = dir.path().join("walk.npy");
+    let mut req = request(dir.path().join("walk"), out.clone());
+    req.params.root_motion = anim_pca::RootMotion::Extract;
+    req.frames = 400;
+    let summary = run_jumpmap(&req, None).unwrap();
+    assert!(summary.stats.transitions > 5, "{summary:?}");
+    let (_, data) = read_npy(&out);
+    let centroid_x = |t: usize| {
+        data[t * SIDE * SIDE * 3..(t + 1) * SIDE * SIDE * 3]
+            .chunks(3)
+            .map(|p| p[0])
+            .sum::<f32>()
+            / (SIDE * SIDE) as f32
+    };
+    // 400 frames at 0.25 per frame: it walks ten times the clip's own 40-frame distance.
+    for t in 1..400 {
+        let dx = centroid_x(t) - centroid_x(t - 1);
+        assert!((dx - 0.25).abs() < 1e-3, "frame {t}: step {dx}");
+    }
 }
