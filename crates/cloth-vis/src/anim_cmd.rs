@@ -337,7 +337,12 @@ pub fn run_jumpmap(
             };
             meshio::write_glb_animation(out, &animation)?;
         }
-        OutKind::ObjFolder => write_obj_frames(out, &frames, &clip.triangles)?,
+        OutKind::ObjFolder => write_obj_frames(
+            out,
+            &frames,
+            &clip.triangles,
+            "cloth-vis anim jumpmap, generated",
+        )?,
     }
     if let Some(dir) = &request.maps {
         write_maps(dir, &map)?;
@@ -350,8 +355,14 @@ pub fn run_jumpmap(
     })
 }
 
-/// Numbered OBJ frames `frame_00000.obj` … in `dir` (created), each written atomically.
-fn write_obj_frames(dir: &Path, frames: &[Vec<Vec3>], triangles: &[[u32; 3]]) -> Result<(), Error> {
+/// Numbered OBJ frames `frame_00000.obj` … in `dir` (created), each written atomically, with
+/// the comment line `# {what}, frame N`.
+pub(crate) fn write_obj_frames(
+    dir: &Path,
+    frames: &[Vec<Vec3>],
+    triangles: &[[u32; 3]],
+    what: &str,
+) -> Result<(), Error> {
     std::fs::create_dir_all(dir).map_err(|e| Error::Io {
         path: dir.to_owned(),
         reason: e.to_string(),
@@ -359,7 +370,7 @@ fn write_obj_frames(dir: &Path, frames: &[Vec<Vec3>], triangles: &[[u32; 3]]) ->
     for (f, positions) in frames.iter().enumerate() {
         let path = dir.join(format!("frame_{f:05}.obj"));
         meshio::write_atomic(&path, |w| {
-            writeln!(w, "# cloth-vis anim jumpmap, generated frame {f}")?;
+            writeln!(w, "# {what}, frame {f}")?;
             for p in positions {
                 writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
             }
@@ -434,18 +445,11 @@ fn write_heat_map(path: &Path, matrix: &anim_pca::SquareMatrix, log: bool) -> Re
             v / max
         }
     };
-    let image = image::RgbImage::from_fn(side, side, |x, y| {
-        image::Rgb(ramp(value(y as usize / scale, x as usize / scale)))
+    let image = image::RgbaImage::from_fn(side, side, |x, y| {
+        let [r, g, b] = ramp(value(y as usize / scale, x as usize / scale));
+        image::Rgba([r, g, b, 255])
     });
-    let mut png = Vec::new();
-    image
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .map_err(|e| Error::Io {
-            path: path.to_owned(),
-            reason: e.to_string(),
-        })?;
-    meshio::write_atomic(path, |w| w.write_all(&png))?;
-    Ok(())
+    write_png(path, &image)
 }
 
 /// Parses `--cell-at FRAME:CELL`.

@@ -34,6 +34,7 @@
 //! ```
 
 pub mod anim_cmd;
+pub mod anim_compress_cmd;
 pub mod camera;
 pub mod demo;
 pub mod effects;

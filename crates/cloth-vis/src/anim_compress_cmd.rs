@@ -1,0 +1,413 @@
+//! `cloth-vis anim compress | decompress | stats`: the clustered-PCA (CPCA) codec of crate
+//! `anim-pca` (thesis §3.3.2, eqs. 3.14–3.18; `anim_pca::compress`) on files.
+//!
+//! - `compress` loads a clip (folder of numbered OBJ frames, `.npy` [F, V, 3] or an animated
+//!   glTF), encodes it with [`Compressed::encode`] and writes the `.cpca` container.
+//! - `decompress` reads a `.cpca`, rebuilds every frame with the CPU [`Decoder`] and writes
+//!   them as `.npy` [F, V, 3], a `.glb` morph-target animation or a folder of OBJ frames,
+//!   with the triangles stored in the file.
+//! - `stats` compares a `.cpca` with its original: bpvf by eqs. 3.16–3.18 and from the file
+//!   size, d_a (Karni–Gotsman) and the worst d_f.
+//!
+//! Every output is written atomically (`meshio::write_atomic`): a refused request or a
+//! failed decode leaves no partial file behind. A corrupt `.cpca` gets the decoder's error
+//! prefixed with the file's path.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anim_pca::compress::{Compressed, CpcaParams, Decoder, Distortion, RateParams, bpvf_from_file};
+use glam::Vec3;
+
+use crate::Error;
+
+/// What `cloth-vis anim compress` was asked to do.
+#[derive(Clone, Debug)]
+pub struct CompressRequest {
+    /// The clip: a folder of numbered OBJ frames, `.npy` [F, V, 3] or an animated glTF.
+    pub input: PathBuf,
+    /// k, c, c*, q_c, q_w, seed and the local-PCA limits.
+    pub params: CpcaParams,
+    /// The `.cpca` file to write.
+    pub out: PathBuf,
+}
+
+/// What `compress` produced and measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompressSummary {
+    /// Vertices V.
+    pub vertices: usize,
+    /// Frames F.
+    pub frames: usize,
+    /// Triangles stored.
+    pub triangles: usize,
+    /// The rate parameters actually used (k and c after clamping, c*, q_c, q_w).
+    pub rate: RateParams,
+    /// Size of the written file in bytes.
+    pub file_bytes: usize,
+    /// d_a and d_f of the decoded clip against the input.
+    pub distortion: Distortion,
+    /// Wall-clock seconds of [`Compressed::encode`] (fit, time PCA, quantization).
+    pub encode_seconds: f64,
+}
+
+impl CompressSummary {
+    /// Bits per vertex per frame of the written file (everything counted).
+    pub fn bpvf_file(&self) -> f64 {
+        bpvf_from_file(self.file_bytes, self.vertices, self.frames)
+    }
+
+    /// One line for the terminal: V, F, k, c, c*, q_c/q_w, file size, bpvf, d_a, worst d_f
+    /// and the encode time.
+    pub fn line(&self) -> String {
+        let r = &self.rate;
+        let (worst_frame, worst) = worst_frame(&self.distortion);
+        format!(
+            "compress: V = {}, F = {}, {} triangles, k = {}, c = {}, c* = {}, q_c = {}, q_w = {}: \
+             {} bytes, {:.3} bpvf (file), d_a = {:.4}, worst d_f = {:.4e} (frame {}), \
+             encoded in {:.2} s",
+            self.vertices,
+            self.frames,
+            self.triangles,
+            r.clusters,
+            r.components,
+            time_text(r.time_components),
+            r.bits_components,
+            r.bits_weights,
+            self.file_bytes,
+            self.bpvf_file(),
+            self.distortion.da,
+            worst,
+            worst_frame,
+            self.encode_seconds
+        )
+    }
+}
+
+/// What `cloth-vis anim decompress` was asked to do.
+#[derive(Clone, Debug)]
+pub struct DecompressRequest {
+    /// The `.cpca` file.
+    pub input: PathBuf,
+    /// `.npy` ([F, V, 3] f32), `.glb` (morph-target animation) or a folder (no extension) of
+    /// `frame_00000.obj` …
+    pub out: PathBuf,
+}
+
+/// What `decompress` wrote.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DecompressSummary {
+    /// Vertices V.
+    pub vertices: usize,
+    /// Frames F.
+    pub frames: usize,
+    /// Triangles written.
+    pub triangles: usize,
+    /// Wall-clock seconds of decoding all frames (not reading or writing).
+    pub decode_seconds: f64,
+}
+
+impl DecompressSummary {
+    /// One line for the terminal.
+    pub fn line(&self) -> String {
+        format!(
+            "decompress: {} frames x {} vertices, {} triangles, decoded in {:.3} s ({:.0} frames/s)",
+            self.frames,
+            self.vertices,
+            self.triangles,
+            self.decode_seconds,
+            self.frames as f64 / self.decode_seconds.max(f64::MIN_POSITIVE)
+        )
+    }
+}
+
+/// What `cloth-vis anim stats` measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StatsSummary {
+    /// The rate parameters stored in the file.
+    pub rate: RateParams,
+    /// Size of the `.cpca` file in bytes.
+    pub file_bytes: usize,
+    /// d_a and d_f of the file's frames against the original.
+    pub distortion: Distortion,
+}
+
+impl StatsSummary {
+    /// Bits per vertex per frame of the file (everything counted).
+    pub fn bpvf_file(&self) -> f64 {
+        bpvf_from_file(self.file_bytes, self.rate.vertices, self.rate.frames)
+    }
+
+    /// The frame with the largest d_f and that d_f.
+    pub fn worst_df(&self) -> (usize, f64) {
+        worst_frame(&self.distortion)
+    }
+
+    /// One line for the terminal.
+    pub fn line(&self) -> String {
+        let r = &self.rate;
+        let eq_3_18 = r
+            .eq_3_18()
+            .map_or_else(|| "-".to_owned(), |b| format!("{b:.3}"));
+        let (frame, worst) = self.worst_df();
+        format!(
+            "stats: V = {}, F = {}, k = {}, c = {}, c* = {}, q_c = {}, q_w = {}: bpvf eq. 3.16 = \
+             {:.3}, eq. 3.17 = {:.3}, eq. 3.18 = {}, file = {:.3} ({} bytes); d_a = {:.4}, \
+             worst d_f = {:.4e} (frame {})",
+            r.vertices,
+            r.frames,
+            r.clusters,
+            r.components,
+            time_text(r.time_components),
+            r.bits_components,
+            r.bits_weights,
+            r.eq_3_16(),
+            r.eq_3_17(),
+            eq_3_18,
+            self.bpvf_file(),
+            self.file_bytes,
+            self.distortion.da,
+            worst,
+            frame
+        )
+    }
+}
+
+fn time_text(cs: Option<usize>) -> String {
+    cs.map_or_else(|| "-".to_owned(), |c| c.to_string())
+}
+
+/// Index and value of the largest d_f (frame 0 and 0 for an empty list).
+fn worst_frame(d: &Distortion) -> (usize, f64) {
+    d.df.iter().copied().enumerate().fold(
+        (0, 0.0),
+        |best, (f, x)| if x > best.1 { (f, x) } else { best },
+    )
+}
+
+fn invalid(path: &Path, message: String) -> Error {
+    Error::Request {
+        path: path.to_owned(),
+        message,
+    }
+}
+
+fn anim_error(path: &Path, e: anim_pca::AnimPcaError) -> Error {
+    invalid(path, e.to_string())
+}
+
+/// The kind of output a decompressed animation goes to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum OutKind {
+    Npy,
+    Glb,
+    ObjFolder,
+}
+
+/// The output kind `out` names, or an error naming it and the supported kinds.
+fn out_kind(out: &Path) -> Result<OutKind, Error> {
+    match out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("npy") => Ok(OutKind::Npy),
+        Some("glb") => Ok(OutKind::Glb),
+        None => Ok(OutKind::ObjFolder),
+        Some(other) => Err(invalid(
+            out,
+            format!(
+                "output extension .{other} is not supported: use .npy ([F, V, 3]), .glb \
+                 (morph-target animation) or a folder name without extension (OBJ frames)"
+            ),
+        )),
+    }
+}
+
+/// Refuses a `--out` of `compress` that does not end in `.cpca`.
+fn check_cpca_out(out: &Path) -> Result<(), Error> {
+    if out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("cpca"))
+    {
+        Ok(())
+    } else {
+        Err(invalid(
+            out,
+            "compress writes the .cpca container: give a file name ending in .cpca".to_owned(),
+        ))
+    }
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>, Error> {
+    std::fs::read(path).map_err(|e| Error::Io {
+        path: path.to_owned(),
+        reason: e.to_string(),
+    })
+}
+
+/// Reads and validates a `.cpca` file; any decoder error is prefixed with the path.
+///
+/// Returns the animation and the file size in bytes.
+///
+/// # Errors
+/// [`Error::Io`] if the file cannot be read; [`Error::Request`] naming the file with the
+/// decoder's message if it is not a valid `.cpca` (bad magic, version, size, checksum, …).
+pub fn read_cpca(path: &Path) -> Result<(Compressed, usize), Error> {
+    let bytes = read_bytes(path)?;
+    let data = Compressed::from_bytes(&bytes).map_err(|e| anim_error(path, e))?;
+    Ok((data, bytes.len()))
+}
+
+/// Runs `compress`: load, encode, write the `.cpca` atomically, and measure the distortion of
+/// the decoded result.
+///
+/// # Errors
+/// An output name not ending in `.cpca`, refused before loading; loader errors naming the
+/// input; encoder errors (bad parameters, a clip too large for the format) naming the input;
+/// write errors naming the output.
+pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error> {
+    check_cpca_out(&request.out)?;
+    let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
+    let start = Instant::now();
+    let packed = Compressed::encode(
+        &clip.frames,
+        &clip.triangles,
+        clip.frame_rate,
+        &request.params,
+    )
+    .map_err(|e| anim_error(&request.input, e))?;
+    let encode_seconds = start.elapsed().as_secs_f64();
+    let bytes = packed.to_bytes();
+    let distortion = Decoder::new(&packed)
+        .distortion(&clip.frames)
+        .map_err(|e| anim_error(&request.input, e))?;
+    meshio::write_atomic(&request.out, |w| w.write_all(&bytes))?;
+    Ok(CompressSummary {
+        vertices: packed.vertices(),
+        frames: packed.frames(),
+        triangles: packed.triangles().len(),
+        rate: packed.rate(),
+        file_bytes: bytes.len(),
+        distortion,
+        encode_seconds,
+    })
+}
+
+/// Runs `decompress`: read and validate the `.cpca`, decode every frame, write them.
+///
+/// # Errors
+/// An unsupported output extension, refused before reading; a corrupt file (the decoder's
+/// message prefixed with its path); a `.glb` output of a file without triangles; write errors
+/// naming the output. Nothing is written on error.
+pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, Error> {
+    let kind = out_kind(&request.out)?;
+    let (data, _) = read_cpca(&request.input)?;
+    if kind == OutKind::Glb && data.triangles().is_empty() {
+        return Err(invalid(
+            &request.input,
+            "the file stores no triangles (it was compressed from an .npy clip): write .npy \
+             or an OBJ folder instead of .glb"
+                .to_owned(),
+        ));
+    }
+    let start = Instant::now();
+    let frames = Decoder::new(&data).decode_all();
+    let decode_seconds = start.elapsed().as_secs_f64();
+    write_frames(
+        &request.out,
+        kind,
+        frames,
+        data.triangles(),
+        data.frame_rate(),
+    )?;
+    Ok(DecompressSummary {
+        vertices: data.vertices(),
+        frames: data.frames(),
+        triangles: data.triangles().len(),
+        decode_seconds,
+    })
+}
+
+/// Runs `stats`: the rate of `cpca` (eqs. 3.16–3.18 and file size) and its distortion
+/// against `original`.
+///
+/// # Errors
+/// A corrupt `.cpca` (the decoder's message prefixed with its path); loader errors naming the
+/// original; a vertex or frame count that differs between the two, naming both files and
+/// counts.
+pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
+    let (data, file_bytes) = read_cpca(cpca)?;
+    let (clip, _) = meshio::load_animation(original, &meshio::AnimationOptions::default())?;
+    let (f, v) = (
+        clip.frames.len(),
+        clip.frames.first().map_or(0, std::vec::Vec::len),
+    );
+    if (f, v) != (data.frames(), data.vertices()) {
+        return Err(invalid(
+            original,
+            format!(
+                "has {f} frames x {v} vertices but {} holds {} frames x {} vertices; compare a \
+                 .cpca with the clip it was compressed from",
+                cpca.display(),
+                data.frames(),
+                data.vertices()
+            ),
+        ));
+    }
+    let distortion = Decoder::new(&data)
+        .distortion(&clip.frames)
+        .map_err(|e| anim_error(original, e))?;
+    Ok(StatsSummary {
+        rate: data.rate(),
+        file_bytes,
+        distortion,
+    })
+}
+
+/// Writes decoded frames to `out` as `kind`.
+fn write_frames(
+    out: &Path,
+    kind: OutKind,
+    frames: Vec<Vec<Vec3>>,
+    triangles: &[[u32; 3]],
+    frame_rate: f32,
+) -> Result<(), Error> {
+    match kind {
+        OutKind::Npy => {
+            let vertices = frames.first().map_or(0, Vec::len);
+            let data: Vec<f32> = frames
+                .iter()
+                .flat_map(|f| f.iter().flat_map(|v| v.to_array()))
+                .collect();
+            meshio::write_npy_f32(out, &[frames.len(), vertices, 3], &data)?;
+        }
+        OutKind::Glb => {
+            let animation = meshio::Animation {
+                triangles: triangles.to_vec(),
+                frames,
+                frame_rate: glb_frame_rate(frame_rate),
+                uvs: None,
+            };
+            meshio::write_glb_animation(out, &animation)?;
+        }
+        OutKind::ObjFolder => {
+            crate::anim_cmd::write_obj_frames(out, &frames, triangles, "cloth-vis anim decompress")?
+        }
+    }
+    Ok(())
+}
+
+/// Frame rate written to a `.glb` when the file's is not a positive number (the loaders'
+/// default, 30 fps).
+const FALLBACK_FRAME_RATE: f32 = 30.0;
+
+fn glb_frame_rate(rate: f32) -> f32 {
+    if rate.is_finite() && rate > 0.0 {
+        rate
+    } else {
+        FALLBACK_FRAME_RATE
+    }
+}

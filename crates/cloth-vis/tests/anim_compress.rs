@@ -1,0 +1,357 @@
+//! `cloth-vis anim compress | decompress | stats` on a small synthetic clip written as `.npy`:
+//! the round trip through the binary reproduces the clip within the quantization tolerance,
+//! `stats` prints the library's numbers, and bad input (a corrupt file, an unsupported output,
+//! mismatched counts) is refused with the file named and nothing written.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use anim_pca::compress::{Compressed, Decoder, bpvf_from_file};
+use cloth_vis::anim_compress_cmd::{
+    CompressRequest, DecompressRequest, run_compress, run_decompress, run_stats,
+};
+use glam::Vec3;
+
+const VERTICES: usize = 64;
+const FRAMES: usize = 40;
+/// Half-length of a bar; the clip spans about 10 + 2·BAR units.
+const BAR: f32 = 2.0;
+
+/// Two bars of 32 vertices, each rotating about its own centre at its own rate (independently
+/// moving parts: no single low-rank basis serves both).
+fn clip() -> Vec<Vec<Vec3>> {
+    (0..FRAMES)
+        .map(|t| {
+            (0..VERTICES)
+                .map(|m| {
+                    let (part, s) = (m / 32, (m % 32) as f32 / 8.0 - BAR);
+                    let a = t as f32 * if part == 0 { 0.10 } else { 0.23 };
+                    Vec3::new(10.0 * part as f32 + s * a.cos(), s * a.sin(), 0.3 * s)
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn flat(frames: &[Vec<Vec3>]) -> Vec<f32> {
+    frames
+        .iter()
+        .flat_map(|f| f.iter().flat_map(|p| p.to_array()))
+        .collect()
+}
+
+/// Writes the clip as `clip.npy` in `dir` and returns its path and frames.
+fn write_clip(dir: &Path) -> (PathBuf, Vec<Vec<Vec3>>) {
+    let frames = clip();
+    let path = dir.join("clip.npy");
+    meshio::write_npy_f32(&path, &[FRAMES, VERTICES, 3], &flat(&frames)).unwrap();
+    (path, frames)
+}
+
+fn cli(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cloth-vis"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn text(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[track_caller]
+fn assert_ok(out: &Output) -> String {
+    assert!(
+        out.status.success(),
+        "exit {:?}, stderr: {}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout.clone()).unwrap()
+}
+
+#[track_caller]
+fn assert_fails_naming(out: &Output, needles: &[&str]) -> String {
+    assert!(
+        !out.status.success(),
+        "expected failure, got {:?}",
+        out.status
+    );
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    for n in needles {
+        assert!(err.contains(n), "stderr {err:?} does not contain {n:?}");
+    }
+    err
+}
+
+#[test]
+fn round_trip_through_the_cli_reproduces_the_clip_and_stats_match_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, frames) = write_clip(dir.path());
+    let cpca = dir.path().join("clip.cpca");
+    let out = cli(&[
+        "anim",
+        "compress",
+        text(&input),
+        "--clusters",
+        "2",
+        "--components",
+        "4",
+        "--out",
+        text(&cpca),
+    ]);
+    let line = assert_ok(&out);
+    assert!(line.starts_with("compress: V = 64, F = 40"), "{line}");
+    assert!(
+        line.contains("k = 2, c = 4, c* = -, q_c = 18, q_w = 18"),
+        "{line}"
+    );
+
+    let decoded = dir.path().join("decoded.npy");
+    assert_ok(&cli(&[
+        "anim",
+        "decompress",
+        text(&cpca),
+        "--out",
+        text(&decoded),
+    ]));
+    let array = meshio::read_npy_f32(&decoded).unwrap();
+    assert_eq!(array.shape, vec![FRAMES, VERTICES, 3]);
+
+    // The file decodes, in the library, to exactly what the CLI wrote.
+    let bytes = std::fs::read(&cpca).unwrap();
+    let packed = Compressed::from_bytes(&bytes).unwrap();
+    let decoder = Decoder::new(&packed);
+    assert_eq!(array.data, flat(&decoder.decode_all()));
+
+    // Each part has rank ≤ 3 about its mean and c = 4, so only quantization is left: 18-bit
+    // steps are about 4e-6 of each array's range; allow 1e-4 of the clip's extent.
+    let extent = 10.0 + 2.0 * BAR;
+    let worst = array
+        .data
+        .iter()
+        .zip(flat(&frames))
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-4 * extent, "max |Δ| = {worst}");
+
+    // stats prints the library's numbers.
+    let stats = assert_ok(&cli(&["anim", "stats", text(&input), text(&cpca)]));
+    let d = decoder.distortion(&frames).unwrap();
+    let rate = packed.rate();
+    let (worst_frame, worst_df) =
+        d.df.iter()
+            .copied()
+            .enumerate()
+            .fold((0, 0.0), |b, (f, x)| if x > b.1 { (f, x) } else { b });
+    assert_eq!(worst_df, d.worst_df());
+    for expected in [
+        format!("eq. 3.16 = {:.3}", rate.eq_3_16()),
+        format!("eq. 3.17 = {:.3}", rate.eq_3_17()),
+        format!(
+            "file = {:.3} ({} bytes)",
+            bpvf_from_file(bytes.len(), VERTICES, FRAMES),
+            bytes.len()
+        ),
+        format!("d_a = {:.4}", d.da),
+        format!("worst d_f = {worst_df:.4e} (frame {worst_frame})"),
+    ] {
+        assert!(stats.contains(&expected), "{stats:?} lacks {expected:?}");
+    }
+    // The library call agrees with the binary.
+    let summary = run_stats(&input, &cpca).unwrap();
+    assert_eq!(summary.line(), stats.trim_end());
+    assert_eq!(summary.distortion, d);
+}
+
+#[test]
+fn time_compression_and_obj_folder_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = write_clip(dir.path());
+    let cpca = dir.path().join("t.cpca");
+    let params = anim_pca::compress::CpcaParams {
+        clusters: 2,
+        components: 4,
+        time_components: Some(8),
+        ..Default::default()
+    };
+    let summary = run_compress(&CompressRequest {
+        input: input.clone(),
+        params,
+        out: cpca.clone(),
+    })
+    .unwrap();
+    assert_eq!(summary.rate.time_components, Some(8));
+    assert_eq!(
+        summary.file_bytes,
+        std::fs::metadata(&cpca).unwrap().len() as usize
+    );
+    assert!(summary.distortion.da.is_finite());
+    let folder = dir.path().join("frames");
+    run_decompress(&DecompressRequest {
+        input: cpca.clone(),
+        out: folder.clone(),
+    })
+    .unwrap();
+    // The clip came from .npy, so the frames are vertex-only OBJ (which meshio's loader
+    // refuses as an animation): read the `v` lines directly.
+    let expected =
+        Decoder::new(&Compressed::from_bytes(&std::fs::read(&cpca).unwrap()).unwrap()).decode_all();
+    assert_eq!(std::fs::read_dir(&folder).unwrap().count(), FRAMES);
+    for (f, b) in expected.iter().enumerate() {
+        let obj = std::fs::read_to_string(folder.join(format!("frame_{f:05}.obj"))).unwrap();
+        let a: Vec<Vec3> = obj
+            .lines()
+            .filter_map(|l| l.strip_prefix("v "))
+            .map(|l| {
+                let xyz: Vec<f32> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+                Vec3::from_slice(&xyz)
+            })
+            .collect();
+        // OBJ holds the shortest round-tripping decimal of each f32: exact.
+        assert_eq!(&a, b, "frame {f}");
+    }
+    // Same parameters and seed: the same file.
+    let again = dir.path().join("again.cpca");
+    run_compress(&CompressRequest {
+        input,
+        params,
+        out: again.clone(),
+    })
+    .unwrap();
+    assert_eq!(
+        std::fs::read(&again).unwrap(),
+        std::fs::read(&cpca).unwrap()
+    );
+}
+
+#[test]
+fn corrupt_file_is_refused_naming_it_and_nothing_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = write_clip(dir.path());
+    let cpca = dir.path().join("clip.cpca");
+    assert_ok(&cli(&[
+        "anim",
+        "compress",
+        text(&input),
+        "--clusters",
+        "2",
+        "--components",
+        "4",
+        "--out",
+        text(&cpca),
+    ]));
+    let mut bytes = std::fs::read(&cpca).unwrap();
+    // A payload byte: the checksum catches it. The magic: refused before anything else.
+    for at in [bytes.len() / 2, 0] {
+        bytes[at] ^= 0x5a;
+        let bad = dir.path().join(format!("bad_{at}.cpca"));
+        std::fs::write(&bad, &bytes).unwrap();
+        bytes[at] ^= 0x5a;
+        for out in ["bad.npy", "bad.glb", "bad_frames"] {
+            let out = dir.path().join(out);
+            let run = cli(&["anim", "decompress", text(&bad), "--out", text(&out)]);
+            assert_fails_naming(&run, &[text(&bad)]);
+            assert!(!out.exists(), "{} was written", out.display());
+        }
+        let run = cli(&["anim", "stats", text(&input), text(&bad)]);
+        assert_fails_naming(&run, &[text(&bad)]);
+    }
+    // No temporary files left behind either.
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        names
+            .iter()
+            .all(|n| n.ends_with(".npy") || n.ends_with(".cpca")),
+        "{names:?}"
+    );
+}
+
+#[test]
+fn unsupported_outputs_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    // The inputs do not exist: an error naming the output proves nothing was read.
+    let missing = dir.path().join("missing.cpca");
+    let out = dir.path().join("out.txt");
+    let run = cli(&["anim", "decompress", text(&missing), "--out", text(&out)]);
+    let err = assert_fails_naming(&run, &[text(&out), ".txt", ".npy", ".glb"]);
+    assert!(!err.contains("missing.cpca"), "{err}");
+
+    let missing_clip = dir.path().join("missing.npy");
+    let out = dir.path().join("clip.npy");
+    let run = cli(&["anim", "compress", text(&missing_clip), "--out", text(&out)]);
+    let err = assert_fails_naming(&run, &[text(&out), ".cpca"]);
+    assert!(!err.contains("missing.npy"), "{err}");
+    assert!(!out.exists());
+
+    // A .glb needs triangles, and a clip from .npy has none: refused before decoding.
+    let (input, _) = write_clip(dir.path());
+    let cpca = dir.path().join("clip.cpca");
+    let params = anim_pca::compress::CpcaParams {
+        clusters: 2,
+        ..Default::default()
+    };
+    run_compress(&CompressRequest {
+        input,
+        params,
+        out: cpca.clone(),
+    })
+    .unwrap();
+    let glb = dir.path().join("clip.glb");
+    let err = run_decompress(&DecompressRequest {
+        input: cpca.clone(),
+        out: glb.clone(),
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains(text(&cpca)) && err.contains("triangles"),
+        "{err}"
+    );
+    assert!(!glb.exists());
+
+    // A bad parameter names itself and its value; nothing is written.
+    let bad = dir.path().join("bad.cpca");
+    let run = cli(&[
+        "anim",
+        "compress",
+        text(&dir.path().join("clip.npy")),
+        "--qc",
+        "33",
+        "--out",
+        text(&bad),
+    ]);
+    assert_fails_naming(&run, &["bits_components", "33"]);
+    assert!(!bad.exists());
+}
+
+#[test]
+fn stats_refuses_mismatched_counts_naming_both_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, frames) = write_clip(dir.path());
+    let cpca = dir.path().join("clip.cpca");
+    assert_ok(&cli(&[
+        "anim",
+        "compress",
+        text(&input),
+        "--clusters",
+        "2",
+        "--out",
+        text(&cpca),
+    ]));
+    let short = dir.path().join("short.npy");
+    meshio::write_npy_f32(&short, &[FRAMES - 1, VERTICES, 3], &flat(&frames[1..])).unwrap();
+    let run = cli(&["anim", "stats", text(&short), text(&cpca)]);
+    assert_fails_naming(
+        &run,
+        &[
+            text(&short),
+            text(&cpca),
+            &format!("{} frames x {VERTICES} vertices", FRAMES - 1),
+            &format!("{FRAMES} frames x {VERTICES} vertices"),
+        ],
+    );
+}
