@@ -382,9 +382,10 @@ impl<'a> Player<'a> {
                 None => break,
             }
         }
-        // Every core frame with a predecessor is a candidate from a cell's last frame, and
-        // every frame is one from any other frame; a 1-candidate-less route can only happen
-        // for a target core without such frames: enter at the core's first frame.
+        // Any target is a candidate from a frame with a successor, and any target with a
+        // predecessor from a cell's last frame. So `best` is empty only when the window is a
+        // lone last frame and no target-core frame has a predecessor (a one-frame core at the
+        // start of its cell): then enter at that frame.
         best.map_or((i, targets.first().copied().unwrap_or(i)), |(_, k, j)| {
             (k, j)
         })
