@@ -12,14 +12,19 @@
 //!   (E, E* beside the thesis's), analysis time and playback frames/s, and the σ and q sweeps
 //!   of Figs. 3.8–3.10 as numbers (`target/repro/jumpmap.md`, `jumpmap.svg` and a rendered
 //!   strip of frames per sequence, `jumpmap-<sequence>.png`).
+//! - `cargo xtask repro anim-compression`: clustered-PCA compression (thesis §3.3) on every
+//!   animation and the synthetic cloth — rate–distortion of CPCA against plain PCA and
+//!   per-frame quantization, the Table 3.4 front, Figs. 3.14/3.15/3.17 and Table 3.5 on the
+//!   chicken, cluster pictures (`target/repro/anim-compression.md` and its plots).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 
 mod compare_clustering;
-mod plot;
+mod repro_anim_compression;
 mod repro_jumpmap;
 mod repro_lightsphere;
 mod repro_visibility;
+mod sequences;
 
 use std::path::PathBuf;
 
@@ -77,6 +82,14 @@ enum Repro {
     /// Jump maps (thesis §3.2.3): Tables 3.1 and 3.2, analysis and playback speed, σ and q
     /// sweeps (Figs. 3.8–3.10 as numbers) and a strip of frames per sequence.
     Jumpmap,
+    /// Clustered-PCA compression (thesis §3.3): rate–distortion against plain PCA and
+    /// per-frame quantization (Table 3.4), c* and q_c × q_w sweeps (Figs. 3.14, 3.15, 3.17),
+    /// timings (Table 3.5) and cluster pictures (Figs. 3.12/3.13).
+    AnimCompression {
+        /// Only the sequences whose name contains this (e.g. `chicken`).
+        #[arg(long)]
+        only: Option<String>,
+    },
 }
 
 /// `target/repro` of the workspace.
@@ -97,6 +110,9 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Jumpmap,
         } => repro_jumpmap::run(&repro_dir()?),
+        Command::Repro {
+            what: Repro::AnimCompression { only },
+        } => repro_anim_compression::run(&repro_dir()?, only.as_deref()),
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {

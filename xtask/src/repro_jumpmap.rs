@@ -20,7 +20,7 @@
 //! `jumpmap.svg` and `jumpmap-<sequence>.png`.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use anim_pca::jumpmap::metrics::{
@@ -32,8 +32,9 @@ use anyhow::Context as _;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::plot::{Series, log_log_svg};
 use crate::repro_visibility::{cpu_model, write_atomic};
+use crate::sequences::{Sequence, load_sequences};
+use cloth_vis::plot::{Series, log_log_svg};
 
 /// Longest clip analysed; longer ones are cut to their first frames (8 s at 30 fps).
 const MAX_CLIP_FRAMES: usize = 240;
@@ -85,42 +86,6 @@ const STRIP_PANELS: usize = 8;
 /// Panel size of a strip.
 const STRIP_PANEL: [u32; 2] = [192, 192];
 
-/// The synthetic cloth: the default drape, 66 × 66 vertices over 120 frames (4 s at 30 fps),
-/// about a second to simulate on two cores.
-fn cloth_params() -> synth::ClothParams {
-    synth::ClothParams {
-        grid: 66,
-        frames: 120,
-        ..synth::ClothParams::default()
-    }
-}
-
-/// One clip of the report.
-struct Sequence {
-    name: String,
-    source: String,
-    note: String,
-    frames: Vec<Vec<Vec3>>,
-    triangles: Vec<[u32; 3]>,
-}
-
-impl Sequence {
-    fn l(&self) -> usize {
-        self.frames.len()
-    }
-
-    fn n(&self) -> usize {
-        self.frames[0].len()
-    }
-
-    fn slug(&self) -> String {
-        self.name
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
-            .collect()
-    }
-}
-
 /// One configuration of the σ / q sweep.
 struct SweepRow {
     sigma: f64,
@@ -143,110 +108,6 @@ struct Measured {
     playback_fps: f64,
     sweep: Vec<SweepRow>,
     strip: Option<String>,
-}
-
-/// Animation files and OBJ folders under `anim`: a folder holding `.obj` files is one
-/// sequence, `.glb`/`.gltf`/`.npy` files are one each; other folders are searched one level
-/// deeper. Sorted by path.
-fn discover(anim: &Path, depth: usize, out: &mut Vec<PathBuf>) -> anyhow::Result<()> {
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(anim)
-        .with_context(|| format!("listing {}", anim.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .collect();
-    entries.sort();
-    let has_ext = |p: &Path, exts: &[&str]| {
-        p.extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| exts.iter().any(|x| e.eq_ignore_ascii_case(x)))
-    };
-    for path in entries {
-        if path.is_dir() {
-            let has_obj = std::fs::read_dir(&path)
-                .with_context(|| format!("listing {}", path.display()))?
-                .filter_map(|e| e.ok())
-                .any(|e| has_ext(&e.path(), &["obj"]));
-            if has_obj {
-                out.push(path);
-            } else if depth > 0 {
-                discover(&path, depth - 1, out)?;
-            }
-        } else if has_ext(&path, &["glb", "gltf", "npy"]) {
-            out.push(path);
-        }
-    }
-    Ok(())
-}
-
-/// Loads every sequence meshio reads (the others are listed in `skipped`) and the cloth.
-fn load_sequences(skipped: &mut Vec<String>) -> anyhow::Result<Vec<Sequence>> {
-    let root = test_data::data_root();
-    let anim = root.join("anim");
-    if !anim.is_dir() {
-        anyhow::bail!(
-            "missing {}: the jump-map repro needs the shared animations (`../shared/data` \
-             beside the workspace, or set {} to its folder)",
-            anim.display(),
-            test_data::DATA_ENV
-        );
-    }
-    let mut paths = Vec::new();
-    discover(&anim, 2, &mut paths)?;
-    let mut sequences = Vec::new();
-    for path in paths {
-        let name = path
-            .strip_prefix(&anim)
-            .unwrap_or(&path)
-            .to_string_lossy()
-            .into_owned();
-        let start = Instant::now();
-        match meshio::load_animation(&path, &meshio::AnimationOptions::default()) {
-            Ok((mut clip, _)) => {
-                let total = clip.frames.len();
-                if total < 3 {
-                    skipped.push(format!(
-                        "`{name}`: {total} frame(s); a jump map needs a clip"
-                    ));
-                    continue;
-                }
-                let mut note = format!(
-                    "{total} frames at {} fps, loaded in {:.1} s",
-                    clip.frame_rate,
-                    start.elapsed().as_secs_f64()
-                );
-                if total > MAX_CLIP_FRAMES {
-                    clip.frames.truncate(MAX_CLIP_FRAMES);
-                    let _ = write!(note, "; **first {MAX_CLIP_FRAMES} used**");
-                }
-                eprintln!("loaded {name}: {note}");
-                sequences.push(Sequence {
-                    name: name.trim_end_matches(".glb").to_owned(),
-                    source: format!("`anim/{name}`"),
-                    note,
-                    frames: clip.frames,
-                    triangles: clip.triangles,
-                });
-            }
-            Err(e) => skipped.push(format!("`{name}`: meshio could not load it ({e})")),
-        }
-    }
-    let params = cloth_params();
-    let start = Instant::now();
-    let cloth = synth::simulate_cloth(&params)?;
-    let note = format!(
-        "{}×{} grid dropped on a ball, simulated in {:.1} s",
-        params.grid,
-        params.grid,
-        start.elapsed().as_secs_f64()
-    );
-    eprintln!("simulated the cloth: {note}");
-    sequences.push(Sequence {
-        name: "synth-cloth".to_owned(),
-        source: "`synth::simulate_cloth`".to_owned(),
-        note,
-        frames: cloth.frames,
-        triangles: cloth.triangles,
-    });
-    Ok(sequences)
 }
 
 fn median(mut xs: Vec<f64>) -> f64 {
@@ -371,8 +232,11 @@ fn strip(
         &gpu.queue,
         &frames,
         &sequence.triangles,
-        STRIP_PANELS,
-        STRIP_PANEL,
+        &cloth_vis::strip::StripOptions {
+            count: STRIP_PANELS,
+            panel_size: STRIP_PANEL,
+            albedo: None,
+        },
         &path,
     )?;
     cloth_vis::strip::write_png(&path, &image)?;
@@ -433,7 +297,7 @@ fn measure(
 pub fn run(out: &Path) -> anyhow::Result<()> {
     let total = Instant::now();
     let mut skipped = Vec::new();
-    let sequences = load_sequences(&mut skipped)?;
+    let sequences = load_sequences(&mut skipped, MAX_CLIP_FRAMES, "jump-map")?;
     let gpu = gpu_context::GpuContext::new(&gpu_context::GpuOptions::default())
         .map_err(|e| e.to_string());
     match &gpu {

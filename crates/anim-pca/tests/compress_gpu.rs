@@ -47,7 +47,7 @@ fn term_magnitude(packed: &Compressed, f: usize, m: usize) -> Vec3 {
     let j = packed.labels()[m] as usize;
     let mut sum = Vec3::ZERO;
     for a in 0..3 {
-        let mut s = packed.mean(j).value(3 * f + a).abs();
+        let mut s = packed.mean(j, a).value(f).abs();
         for h in 0..packed.components() {
             let w = packed.weights(h).value(m);
             s += (w * packed.eigentrajectory(j, h).value(3 * f + a)).abs();

@@ -68,3 +68,32 @@ fn chicken_rate_distortion() {
     };
     assert!(da(10, 10) < da(1, 16), "{results:?}");
 }
+
+#[path = "compress_common/mod.rs"]
+mod common;
+
+#[test]
+fn chicken_connectivity_is_kept_and_costs_under_30_bits_per_vertex() {
+    let Some(path) = test_data::shared_file("anim/chickenCrossing") else {
+        return;
+    };
+    let (anim, _) = meshio::load_animation(&path, &meshio::AnimationOptions::default()).unwrap();
+    let p = CpcaParams {
+        clusters: 2,
+        components: 2,
+        ..CpcaParams::default()
+    };
+    let frames = &anim.frames[..4];
+    let with = Compressed::encode(frames, &anim.triangles, 30.0, &p).unwrap();
+    let without = Compressed::encode(frames, &[], 30.0, &p).unwrap();
+    let read = Compressed::from_bytes(&with.to_bytes()).unwrap();
+    assert_eq!(
+        common::canonical_triangles(read.triangles()),
+        common::canonical_triangles(&anim.triangles)
+    );
+    // The CONN payload is the size difference (its section header is there either way).
+    let bits_per_vertex = 8.0 * (with.to_bytes().len() - without.to_bytes().len()) as f64
+        / anim.vertex_count() as f64;
+    println!("chicken connectivity: {bits_per_vertex:.1} bits per vertex");
+    assert!(bits_per_vertex < 30.0, "{bits_per_vertex}");
+}

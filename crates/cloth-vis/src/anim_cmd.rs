@@ -307,8 +307,11 @@ pub fn run_jumpmap(
             &gpu.queue,
             &frames,
             &clip.triangles,
-            strip.frames,
-            strip.panel_size,
+            &crate::strip::StripOptions {
+                count: strip.frames,
+                panel_size: strip.panel_size,
+                albedo: None,
+            },
             &strip.path,
         )?;
         write_png(&strip.path, &image)?;

@@ -17,7 +17,10 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anim_pca::compress::{Compressed, CpcaParams, Decoder, Distortion, RateParams, bpvf_from_file};
+use anim_pca::compress::{
+    Compressed, CpcaParams, Decoder, Distortion, RateParams, RateTarget, SearchStep,
+    bpvf_from_file, search_clusters,
+};
 use glam::Vec3;
 
 use crate::Error;
@@ -29,9 +32,17 @@ pub struct CompressRequest {
     pub input: PathBuf,
     /// k, c, c*, q_c, q_w, seed and the local-PCA limits.
     pub params: CpcaParams,
+    /// Search k = 1, 2, … for this target instead of using `params.clusters`
+    /// ([`search_clusters`], thesis §3.3.2).
+    pub target: Option<RateTarget>,
+    /// Largest k the search tries.
+    pub k_max: usize,
     /// The `.cpca` file to write.
     pub out: PathBuf,
 }
+
+/// Largest k `--target-da`/`--target-bpvf` tries unless told (`--k-max`).
+pub const DEFAULT_K_MAX: usize = 32;
 
 /// What `compress` produced and measured.
 #[derive(Clone, Debug, PartialEq)]
@@ -48,8 +59,11 @@ pub struct CompressSummary {
     pub file_bytes: usize,
     /// d_a and d_f of the decoded clip against the input.
     pub distortion: Distortion,
-    /// Wall-clock seconds of [`Compressed::encode`] (fit, time PCA, quantization).
+    /// Wall-clock seconds of [`Compressed::encode`] (fit, time PCA, quantization); with a
+    /// target, of the whole search.
     pub encode_seconds: f64,
+    /// With a target: every k tried, and whether the chosen one meets the target.
+    pub search: Option<(Vec<SearchStep>, bool)>,
 }
 
 impl CompressSummary {
@@ -59,14 +73,23 @@ impl CompressSummary {
     }
 
     /// One line for the terminal: V, F, k, c, c*, q_c/q_w, file size, bpvf, d_a, worst d_f
-    /// and the encode time.
+    /// and the encode time (and, after a search, how many k were tried and whether the
+    /// target was met).
     pub fn line(&self) -> String {
         let r = &self.rate;
         let (worst_frame, worst) = worst_frame(&self.distortion);
+        let search = match &self.search {
+            None => String::new(),
+            Some((steps, true)) => format!(" (target met after trying k = 1..={})", steps.len()),
+            Some((steps, false)) => format!(
+                " (target NOT met by any k in 1..={}; kept the closest)",
+                steps.len()
+            ),
+        };
         format!(
             "compress: V = {}, F = {}, {} triangles, k = {}, c = {}, c* = {}, q_c = {}, q_w = {}: \
              {} bytes, {:.3} bpvf (file), d_a = {:.4}, worst d_f = {:.4e} (frame {}), \
-             encoded in {:.2} s",
+             encoded in {:.2} s{}",
             self.vertices,
             self.frames,
             self.triangles,
@@ -80,7 +103,8 @@ impl CompressSummary {
             self.distortion.da,
             worst,
             worst_frame,
-            self.encode_seconds
+            self.encode_seconds,
+            search
         )
     }
 }
@@ -272,13 +296,37 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
     check_cpca_out(&request.out)?;
     let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
     let start = Instant::now();
-    let packed = Compressed::encode(
-        &clip.frames,
-        &clip.triangles,
-        clip.frame_rate,
-        &request.params,
-    )
-    .map_err(|e| anim_error(&request.input, e))?;
+    let (packed, search) = match request.target {
+        None => (
+            Compressed::encode(
+                &clip.frames,
+                &clip.triangles,
+                clip.frame_rate,
+                &request.params,
+            )
+            .map_err(|e| anim_error(&request.input, e))?,
+            None,
+        ),
+        Some(target) => {
+            let mut report = |s: &SearchStep| {
+                eprintln!(
+                    "  k = {:>3}: d_a = {:.4}, {:.3} bpvf (file), {:.2} s",
+                    s.k, s.da, s.bpvf, s.seconds
+                );
+            };
+            let found = search_clusters(
+                &clip.frames,
+                &clip.triangles,
+                clip.frame_rate,
+                &request.params,
+                target,
+                request.k_max,
+                &mut report,
+            )
+            .map_err(|e| anim_error(&request.input, e))?;
+            (found.compressed, Some((found.steps, found.reached)))
+        }
+    };
     let encode_seconds = start.elapsed().as_secs_f64();
     let bytes = packed.to_bytes();
     let distortion = Decoder::new(&packed)
@@ -293,6 +341,7 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
         file_bytes: bytes.len(),
         distortion,
         encode_seconds,
+        search,
     })
 }
 
@@ -339,6 +388,66 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
 /// original; a vertex or frame count that differs between the two, naming both files and
 /// counts.
 pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
+    run_stats_with_pictures(
+        &StatsRequest {
+            original: original.to_owned(),
+            cpca: cpca.to_owned(),
+            clusters_png: None,
+            error_plot: None,
+        },
+        None,
+    )
+}
+
+/// What `cloth-vis anim stats` was asked to do, pictures included.
+#[derive(Clone, Debug, Default)]
+pub struct StatsRequest {
+    /// The original clip.
+    pub original: PathBuf,
+    /// The `.cpca` file.
+    pub cpca: PathBuf,
+    /// Write the decoded mesh coloured by cluster (thesis Figs. 3.12/3.13) here, as a PNG
+    /// strip of [`crate::strip::DEFAULT_STRIP_FRAMES`] frames (needs a GPU adapter; Mesa's
+    /// lavapipe will do).
+    pub clusters_png: Option<PathBuf>,
+    /// Write d_f against the frame index (thesis Fig. 3.15) here, as an SVG chart.
+    pub error_plot: Option<PathBuf>,
+}
+
+/// Runs `stats` ([`run_stats`]) and writes the pictures `request` asks for. `gpu` is needed
+/// only for `clusters_png`.
+///
+/// # Errors
+/// As [`run_stats`]; a picture path with the wrong extension (refused before any work); a
+/// missing GPU for `clusters_png` or a file without triangles ([`Error::Request`]);
+/// rendering and write errors naming the picture.
+pub fn run_stats_with_pictures(
+    request: &StatsRequest,
+    gpu: Option<&gpu_context::GpuContext>,
+) -> Result<StatsSummary, Error> {
+    let (original, cpca) = (request.original.as_path(), request.cpca.as_path());
+    for (path, ext) in [(&request.clusters_png, "png"), (&request.error_plot, "svg")] {
+        if let Some(p) = path.as_ref().filter(|p| {
+            p.extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase)
+                .as_deref()
+                != Some(ext)
+        }) {
+            return Err(invalid(
+                p,
+                format!("this picture is written as .{ext}; name it so"),
+            ));
+        }
+    }
+    if let (Some(png), None) = (&request.clusters_png, gpu) {
+        return Err(invalid(
+            png,
+            "--clusters-png renders with wgpu and no GPU adapter was found (install Mesa's \
+             lavapipe: apt-get install mesa-vulkan-drivers)"
+                .to_owned(),
+        ));
+    }
     let (data, file_bytes) = read_cpca(cpca)?;
     let (clip, _) = meshio::load_animation(original, &meshio::AnimationOptions::default())?;
     let (f, v) = (
@@ -360,11 +469,68 @@ pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
     let distortion = Decoder::new(&data)
         .distortion(&clip.frames)
         .map_err(|e| anim_error(original, e))?;
+    if let (Some(png), Some(gpu)) = (&request.clusters_png, gpu) {
+        let image = cluster_strip(gpu, &data, png)?;
+        crate::strip::write_png(png, &image)?;
+    }
+    if let Some(svg) = &request.error_plot {
+        let chart = error_chart(&distortion, cpca);
+        meshio::write_atomic(svg, |w| w.write_all(chart.as_bytes()))?;
+    }
     Ok(StatsSummary {
         rate: data.rate(),
         file_bytes,
         distortion,
     })
+}
+
+/// The decoded clip of `data` as a strip of frames, each vertex coloured by its cluster
+/// (thesis Figs. 3.12/3.13), named `what` in errors.
+///
+/// # Errors
+/// [`Error::Request`] when the file has no triangles; rendering errors.
+pub fn cluster_strip(
+    gpu: &gpu_context::GpuContext,
+    data: &Compressed,
+    what: &Path,
+) -> Result<image::RgbaImage, Error> {
+    let frames = Decoder::new(data).decode_all();
+    let colours = crate::strip::label_colours(data.clusters());
+    let albedo: Vec<Vec3> = data.labels().iter().map(|&j| colours[j as usize]).collect();
+    crate::strip::render_strip(
+        &gpu.device,
+        &gpu.queue,
+        &frames,
+        data.triangles(),
+        &crate::strip::StripOptions {
+            count: crate::strip::DEFAULT_STRIP_FRAMES.min(frames.len()),
+            panel_size: crate::strip::DEFAULT_PANEL_SIZE,
+            albedo: Some(&albedo),
+        },
+        what,
+    )
+}
+
+/// d_f per frame (thesis Fig. 3.15) as an SVG chart titled after `cpca`.
+pub fn error_chart(distortion: &Distortion, cpca: &Path) -> String {
+    use crate::plot::{Axis, Series, chart_svg};
+    let name = cpca
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    chart_svg(
+        &format!("d_f per frame, {name} (d_a = {:.4})", distortion.da),
+        ["frame", "d_f (position units)"],
+        [Axis::Linear, Axis::Linear],
+        &[Series {
+            label: "d_f".to_owned(),
+            points: distortion
+                .df
+                .iter()
+                .enumerate()
+                .map(|(f, &d)| (f as f64, d))
+                .collect(),
+        }],
+    )
 }
 
 /// Writes decoded frames to `out` as `kind`.

@@ -41,6 +41,7 @@ pub mod effects;
 mod error;
 pub mod lighting;
 pub mod plan;
+pub mod plot;
 pub mod render;
 pub mod report;
 pub mod run;

@@ -236,6 +236,16 @@ enum AnimCommand {
         /// Seed of the local PCA (same seed, same file).
         #[arg(long, default_value_t = 0)]
         seed: u64,
+        /// Instead of --clusters: the smallest k (from 1) whose decoded clip has d_a ≤ X.
+        #[arg(long, value_name = "X", conflicts_with_all = ["clusters", "target_bpvf"])]
+        target_da: Option<f64>,
+        /// Instead of --clusters: the k of lowest d_a whose file needs ≤ X bits per vertex
+        /// per frame.
+        #[arg(long, value_name = "X", conflicts_with = "clusters")]
+        target_bpvf: Option<f64>,
+        /// Largest k a --target-da/--target-bpvf search tries.
+        #[arg(long, default_value_t = cloth_vis::anim_compress_cmd::DEFAULT_K_MAX)]
+        k_max: usize,
         /// Output: FILE.cpca.
         #[arg(long)]
         out: PathBuf,
@@ -256,6 +266,12 @@ enum AnimCommand {
         original: PathBuf,
         /// The .cpca file.
         cpca: PathBuf,
+        /// Also write the decoded mesh coloured by cluster (Figs. 3.12/3.13) as a PNG strip.
+        #[arg(long, value_name = "FILE.png")]
+        clusters_png: Option<PathBuf>,
+        /// Also write d_f against the frame (Fig. 3.15) as an SVG chart.
+        #[arg(long, value_name = "FILE.svg")]
+        error_plot: Option<PathBuf>,
     },
 }
 
@@ -359,9 +375,17 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     qc,
                     qw,
                     seed,
+                    target_da,
+                    target_bpvf,
+                    k_max,
                     out,
                 },
         } => {
+            let target = match (target_da, target_bpvf) {
+                (Some(x), _) => Some(anim_pca::compress::RateTarget::Distortion(x)),
+                (None, Some(x)) => Some(anim_pca::compress::RateTarget::Bpvf(x)),
+                (None, None) => None,
+            };
             let request = cloth_vis::anim_compress_cmd::CompressRequest {
                 input,
                 params: anim_pca::compress::CpcaParams {
@@ -373,6 +397,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                     seed,
                     ..Default::default()
                 },
+                target,
+                k_max,
                 out,
             };
             let summary = cloth_vis::anim_compress_cmd::run_compress(&request)?;
@@ -386,9 +412,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             writeln!(std::io::stdout().lock(), "{}", summary.line())?;
         }
         Command::Anim {
-            command: AnimCommand::Stats { original, cpca },
+            command:
+                AnimCommand::Stats {
+                    original,
+                    cpca,
+                    clusters_png,
+                    error_plot,
+                },
         } => {
-            let summary = cloth_vis::anim_compress_cmd::run_stats(&original, &cpca)?;
+            let gpu = match clusters_png {
+                Some(_) => gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()).ok(),
+                None => None,
+            };
+            let request = cloth_vis::anim_compress_cmd::StatsRequest {
+                original,
+                cpca,
+                clusters_png,
+                error_plot,
+            };
+            let summary =
+                cloth_vis::anim_compress_cmd::run_stats_with_pictures(&request, gpu.as_ref())?;
             writeln!(std::io::stdout().lock(), "{}", summary.line())?;
         }
         Command::Visibility {

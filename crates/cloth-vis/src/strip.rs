@@ -56,15 +56,52 @@ pub fn strip_frame_indices(total: usize, count: usize) -> Vec<usize> {
         .collect()
 }
 
-/// Shaded linear radiance of a vertex with unit normal `n` (zero normal: ambient only).
-fn shade(n: Vec3) -> Vec3 {
+/// Shaded linear radiance of a vertex with unit normal `n` (zero normal: ambient only) and
+/// linear albedo `albedo`.
+fn shade(n: Vec3, albedo: Vec3) -> Vec3 {
     let light = KEY_LIGHT_DIRECTION.normalize();
-    Vec3::splat(ALBEDO * (AMBIENT + (1.0 - AMBIENT) * n.dot(light).max(0.0)))
+    albedo * (AMBIENT + (1.0 - AMBIENT) * n.dot(light).max(0.0))
 }
 
-/// Renders `count` evenly spaced frames of `frames` ([`strip_frame_indices`]) side by side,
+/// `count` clearly distinct linear-RGB albedos, one per label (cluster pictures, thesis Figs.
+/// 3.12/3.13): hues spread by the golden angle, alternating two lightness levels so that
+/// neighbouring labels differ in brightness too.
+pub fn label_colours(count: usize) -> Vec<Vec3> {
+    (0..count)
+        .map(|i| {
+            let hue = (i as f32 * 0.618_034).fract() * 6.0;
+            let value = if i % 2 == 0 { 0.85 } else { 0.55 };
+            let x = 1.0 - ((hue % 2.0) - 1.0).abs();
+            let (r, g, b) = match hue as u32 {
+                0 => (1.0, x, 0.0),
+                1 => (x, 1.0, 0.0),
+                2 => (0.0, 1.0, x),
+                3 => (0.0, x, 1.0),
+                4 => (x, 0.0, 1.0),
+                _ => (1.0, 0.0, x),
+            };
+            // sRGB-ish primaries at 85% saturation, to linear.
+            let c = |v: f32| ((0.15 + 0.85 * v) * value).powf(2.2);
+            Vec3::new(c(r), c(g), c(b))
+        })
+        .collect()
+}
+
+/// What a strip shows: how many panels, their size, and the vertex colours.
+#[derive(Clone, Copy, Debug)]
+pub struct StripOptions<'a> {
+    /// Panels (evenly spaced frames).
+    pub count: usize,
+    /// Size (width, height) of one panel in pixels.
+    pub panel_size: [u32; 2],
+    /// Linear albedo per vertex (e.g. [`label_colours`] by cluster); `None` draws grey.
+    pub albedo: Option<&'a [Vec3]>,
+}
+
+/// Renders `options.count` evenly spaced frames of `frames` ([`strip_frame_indices`]) side by side,
 /// each `panel_size` pixels, into one RGBA8 image `count · width` × `height`, through one
 /// camera framing the bounding sphere of every frame's vertices that `triangles` use.
+/// `options.albedo` gives each vertex its own linear colour; `None` draws the default grey.
 ///
 /// # Errors
 /// [`Error::Request`] (naming `what`) when there are no frames or triangles, `count` is not in
@@ -75,11 +112,25 @@ pub fn render_strip(
     queue: &wgpu::Queue,
     frames: &[Vec<Vec3>],
     triangles: &[[u32; 3]],
-    count: usize,
-    panel_size: [u32; 2],
+    options: &StripOptions<'_>,
     what: &Path,
 ) -> Result<image::RgbaImage, Error> {
+    let StripOptions {
+        count,
+        panel_size,
+        albedo,
+    } = *options;
     check_strip(frames.len(), count, panel_size, what)?;
+    if let Some(a) = albedo.filter(|a| a.len() != frames[0].len()) {
+        return Err(Error::Request {
+            path: what.to_owned(),
+            message: format!(
+                "{} vertex colours for {} vertices",
+                a.len(),
+                frames[0].len()
+            ),
+        });
+    }
     if triangles.is_empty() {
         return Err(Error::Request {
             path: what.to_owned(),
@@ -107,8 +158,17 @@ pub fn render_strip(
     for (panel, &index) in strip_frame_indices(frames.len(), count).iter().enumerate() {
         let positions = &frames[index];
         let normals = meshio::compute_normals(positions, triangles, meshio::NormalWeighting::Angle);
-        let front: Vec<Vec3> = normals.iter().map(|n| shade(*n)).collect();
-        let back: Vec<Vec3> = normals.iter().map(|n| shade(-*n)).collect();
+        let colour = |m: usize| albedo.map_or(Vec3::splat(ALBEDO), |a| a[m]);
+        let front: Vec<Vec3> = normals
+            .iter()
+            .enumerate()
+            .map(|(m, n)| shade(*n, colour(m)))
+            .collect();
+        let back: Vec<Vec3> = normals
+            .iter()
+            .enumerate()
+            .map(|(m, n)| shade(-*n, colour(m)))
+            .collect();
         let mesh = DrawMesh {
             positions,
             triangles,
@@ -205,9 +265,9 @@ mod tests {
     #[test]
     fn the_lit_side_is_brighter_and_nothing_is_black() {
         let l = KEY_LIGHT_DIRECTION.normalize();
-        assert!((shade(l).x - ALBEDO).abs() < 1e-6);
-        assert!((shade(-l).x - ALBEDO * AMBIENT).abs() < 1e-6);
-        assert_eq!(shade(Vec3::ZERO).x, ALBEDO * AMBIENT);
+        assert!((shade(l, Vec3::splat(ALBEDO)).x - ALBEDO).abs() < 1e-6);
+        assert!((shade(-l, Vec3::splat(ALBEDO)).x - ALBEDO * AMBIENT).abs() < 1e-6);
+        assert_eq!(shade(Vec3::ZERO, Vec3::splat(ALBEDO)).x, ALBEDO * AMBIENT);
     }
 
     #[test]

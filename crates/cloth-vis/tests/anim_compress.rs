@@ -8,7 +8,7 @@ use std::process::{Command, Output};
 
 use anim_pca::compress::{Compressed, Decoder, bpvf_from_file};
 use cloth_vis::anim_compress_cmd::{
-    CompressRequest, DecompressRequest, run_compress, run_decompress, run_stats,
+    CompressRequest, DEFAULT_K_MAX, DecompressRequest, run_compress, run_decompress, run_stats,
 };
 use glam::Vec3;
 
@@ -178,6 +178,8 @@ fn time_compression_and_obj_folder_output() {
     let summary = run_compress(&CompressRequest {
         input: input.clone(),
         params,
+        target: None,
+        k_max: DEFAULT_K_MAX,
         out: cpca.clone(),
     })
     .unwrap();
@@ -216,6 +218,8 @@ fn time_compression_and_obj_folder_output() {
     run_compress(&CompressRequest {
         input,
         params,
+        target: None,
+        k_max: DEFAULT_K_MAX,
         out: again.clone(),
     })
     .unwrap();
@@ -297,6 +301,8 @@ fn unsupported_outputs_are_refused_before_any_work() {
     run_compress(&CompressRequest {
         input,
         params,
+        target: None,
+        k_max: DEFAULT_K_MAX,
         out: cpca.clone(),
     })
     .unwrap();
@@ -353,5 +359,221 @@ fn stats_refuses_mismatched_counts_naming_both_files() {
             &format!("{} frames x {VERTICES} vertices", FRAMES - 1),
             &format!("{FRAMES} frames x {VERTICES} vertices"),
         ],
+    );
+}
+
+/// A GPU context, or `None` after the project's skip policy (fails under CI).
+fn gpu() -> Option<gpu_context::GpuContext> {
+    match gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()) {
+        Ok(g) => Some(g),
+        Err(e) => test_data::skip(&format!("no GPU adapter: {e}")),
+    }
+}
+
+#[test]
+fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
+    // Two bars turning at different rates, c = 2: one cluster holds one rotation (a rank-2
+    // trajectory space) but not both; two clusters hold both exactly.
+    let dir = tempfile::tempdir().unwrap();
+    let (input, frames) = write_clip(dir.path());
+    let cpca = dir.path().join("s.cpca");
+    let out = cli(&[
+        "anim",
+        "compress",
+        text(&input),
+        "--components",
+        "2",
+        "--target-da",
+        "0.05",
+        "--out",
+        text(&cpca),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("k =   1") && stderr.contains("k =   2"),
+        "{stderr}"
+    );
+    assert!(
+        stdout.contains("target met after trying k = 1..=2"),
+        "{stdout}"
+    );
+    let packed = Compressed::from_bytes(&std::fs::read(&cpca).unwrap()).unwrap();
+    assert_eq!(packed.clusters(), 2);
+    let d = Decoder::new(&packed).distortion(&frames).unwrap();
+    assert!(d.da <= 0.05, "d_a = {}", d.da);
+
+    // A budget below what k = 1 needs cannot be met: the smallest file is kept and said so.
+    let tight = dir.path().join("tight.cpca");
+    let out = cli(&[
+        "anim",
+        "compress",
+        text(&input),
+        "--components",
+        "2",
+        "--target-bpvf",
+        "0.5",
+        "--out",
+        text(&tight),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("target NOT met"));
+    let packed = Compressed::from_bytes(&std::fs::read(&tight).unwrap()).unwrap();
+    assert_eq!(packed.clusters(), 1);
+
+    // A generous budget buys the k of lowest d_a within it; the file respects it.
+    let roomy = dir.path().join("roomy.cpca");
+    let summary = run_compress(&CompressRequest {
+        input: input.clone(),
+        params: anim_pca::compress::CpcaParams {
+            components: 2,
+            ..Default::default()
+        },
+        target: Some(anim_pca::compress::RateTarget::Bpvf(40.0)),
+        k_max: 4,
+        out: roomy.clone(),
+    })
+    .unwrap();
+    let (steps, reached) = summary.search.clone().unwrap();
+    assert!(reached);
+    assert!(summary.bpvf_file() <= 40.0);
+    let best = steps
+        .iter()
+        .filter(|s| s.bpvf <= 40.0)
+        .map(|s| s.da)
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(summary.distortion.da, best);
+
+    // Both targets at once, or a target beside --clusters, are refused by the parser.
+    for extra in [
+        &["--target-da", "1", "--target-bpvf", "4"][..],
+        &["--target-da", "1", "--clusters", "3"][..],
+    ] {
+        let bad = dir.path().join("bad.cpca");
+        let mut args = vec!["anim", "compress", text(&input), "--out", text(&bad)];
+        args.extend_from_slice(extra);
+        let out = cli(&args);
+        assert!(!out.status.success(), "{extra:?} accepted");
+        assert!(!bad.exists());
+    }
+}
+
+#[test]
+fn stats_draws_the_error_per_frame_and_the_clusters() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, frames) = write_clip(dir.path());
+    let cpca = dir.path().join("c.cpca");
+    run_compress(&CompressRequest {
+        input: input.clone(),
+        params: anim_pca::compress::CpcaParams {
+            clusters: 2,
+            components: 2,
+            ..Default::default()
+        },
+        target: None,
+        k_max: DEFAULT_K_MAX,
+        out: cpca.clone(),
+    })
+    .unwrap();
+    let svg = dir.path().join("df.svg");
+    let out = cli(&[
+        "anim",
+        "stats",
+        text(&input),
+        text(&cpca),
+        "--error-plot",
+        text(&svg),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let chart = std::fs::read_to_string(&svg).unwrap();
+    assert!(chart.starts_with("<svg") && chart.trim_end().ends_with("</svg>"));
+    // One polyline point per frame.
+    let line = chart.split("<polyline").nth(1).unwrap();
+    let points = line
+        .split("points=\"")
+        .nth(1)
+        .unwrap()
+        .split('"')
+        .next()
+        .unwrap();
+    assert_eq!(points.split_whitespace().count(), frames.len());
+
+    // A wrong picture extension is refused before any work.
+    let out = cli(&[
+        "anim",
+        "stats",
+        text(&input),
+        text(&cpca),
+        "--error-plot",
+        text(&dir.path().join("df.png")),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("df.png"));
+
+    let Some(gpu) = gpu() else { return };
+    // The npy clip has no triangles: a cluster picture of it is refused by name.
+    let request = cloth_vis::anim_compress_cmd::StatsRequest {
+        original: input.clone(),
+        cpca: cpca.clone(),
+        clusters_png: Some(dir.path().join("clusters.png")),
+        error_plot: None,
+    };
+    let e =
+        cloth_vis::anim_compress_cmd::run_stats_with_pictures(&request, Some(&gpu)).unwrap_err();
+    assert!(e.to_string().contains("triangles"), "{e}");
+    assert!(!dir.path().join("clusters.png").exists());
+    // With triangles: two ribbons (the bars given a width along z, so that their triangles
+    // have area), each turning at its own rate; each cluster gets its own colour.
+    let ribbons: Vec<Vec<Vec3>> = (0..FRAMES)
+        .map(|t| {
+            (0..VERTICES)
+                .map(|m| {
+                    let (part, s) = (m / 32, ((m % 32) / 2) as f32 / 4.0 - BAR);
+                    let a = t as f32 * if part == 0 { 0.10 } else { 0.23 };
+                    let z = if m % 2 == 0 { -0.5 } else { 0.5 };
+                    Vec3::new(10.0 * part as f32 + s * a.cos(), s * a.sin(), z)
+                })
+                .collect()
+        })
+        .collect();
+    let triangles: Vec<[u32; 3]> = (0..2u32)
+        .flat_map(|bar| (0..15u32).map(move |q| bar * 32 + 2 * q))
+        .flat_map(|i| [[i, i + 1, i + 2], [i + 1, i + 3, i + 2]])
+        .collect();
+    let packed = Compressed::encode(
+        &ribbons,
+        &triangles,
+        30.0,
+        &anim_pca::compress::CpcaParams {
+            clusters: 2,
+            components: 2,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let image =
+        cloth_vis::anim_compress_cmd::cluster_strip(&gpu, &packed, Path::new("clusters.png"))
+            .unwrap();
+    // Count distinct hues among lit pixels: background plus one per cluster at least.
+    let colours = cloth_vis::strip::label_colours(2);
+    let hue = |c: glam::Vec3| (c.x - c.z).signum();
+    assert_ne!(
+        hue(colours[0]),
+        hue(colours[1]),
+        "the two labels share a hue"
+    );
+    let mut seen = [false; 2];
+    for p in image.pixels() {
+        let [r, _, b, _] = p.0;
+        if r.abs_diff(b) > 40 {
+            seen[usize::from(b > r)] = true;
+        }
+    }
+    assert_eq!(seen, [true, true], "both clusters' colours should appear");
+    let labels = packed.labels();
+    assert_ne!(
+        labels[0], labels[40],
+        "the bars should fall in different clusters"
     );
 }

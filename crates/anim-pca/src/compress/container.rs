@@ -35,7 +35,9 @@ pub struct Compressed {
     pub(crate) frame_rate: f32,
     /// Iₘ, length V.
     pub(crate) labels: Vec<u32>,
-    /// rⱼ, k arrays of length 3F (q_c bits).
+    /// rⱼ per axis: array 3j + a holds axis a of cluster j's mean over the F frames (q_c bits).
+    /// Each axis has its own range, so a clip far from the origin (the chicken sits at
+    /// x ≈ 25) does not spend the bits on its offset.
     pub(crate) means: Vec<Quantized>,
     /// Eⱼₕ at index j·c + h: length 3F, or c* time coefficients with a time basis (q_c).
     pub(crate) eigen: Vec<Quantized>,
@@ -114,14 +116,29 @@ impl Compressed {
         }
         let l = model.local_pca();
         let (qc, qw) = (params.bits_components, params.bits_weights);
-        let means = (0..k).map(|j| Quantized::new(l.mean(j), qc)).collect();
+        let means = (0..k)
+            .flat_map(|j| {
+                (0..3).map(move |a| {
+                    let axis: Vec<f64> = l.mean(j).iter().skip(a).step_by(3).copied().collect();
+                    Quantized::new(&axis, qc)
+                })
+            })
+            .collect();
         let rows: Vec<Vec<f64>> = (0..k)
             .flat_map(|j| (0..c).map(move |h| l.basis(j).col(h).iter().copied().collect()))
             .collect();
         let (eigen, time) = match params.time_components {
             None => (rows.iter().map(|r| Quantized::new(r, qc)).collect(), None),
             Some(cs) => {
-                let (coef, time) = time_pca(&rows, 3 * f, cs, qc, qw)?;
+                // ‖w_·h‖ over cluster j's vertices: how much E_jh moves the mesh.
+                let mut importance = vec![0f64; k * c];
+                for (m, &j) in l.labels().iter().enumerate() {
+                    for (h, w) in l.weight(m).iter().enumerate() {
+                        importance[j * c + h] += w * w;
+                    }
+                }
+                importance.iter_mut().for_each(|s| *s = s.sqrt());
+                let (coef, time) = time_pca(&rows, &importance, 3 * f, cs, qc, qw)?;
                 (coef, Some(time))
             }
         };
@@ -144,7 +161,7 @@ impl Compressed {
             eigen,
             time,
             weights,
-            triangles: triangles.to_vec(),
+            triangles: coded_triangles(triangles, v)?,
         })
     }
 
@@ -198,12 +215,14 @@ impl Compressed {
         &self.triangles
     }
 
-    /// Quantized mean rⱼ of cluster `j` (length 3F).
+    /// Axis `axis` (0 = x, 1 = y, 2 = z) of the quantized mean rⱼ of cluster `j`: F values,
+    /// one per frame.
     ///
     /// # Panics
-    /// If `j ≥ k`.
-    pub fn mean(&self, j: usize) -> &Quantized {
-        &self.means[j]
+    /// If `j ≥ k` or `axis ≥ 3`.
+    pub fn mean(&self, j: usize, axis: usize) -> &Quantized {
+        assert!(axis < 3, "axis {axis} ≥ 3");
+        &self.means[3 * j + axis]
     }
 
     /// Quantized eigentrajectory Eⱼₕ (length 3F), or its c* time coefficients when the
@@ -240,14 +259,37 @@ impl Compressed {
 
 /// PCA of the k·c eigentrajectories (rows of length `d` = 3F) keeping `cs` components;
 /// returns the quantized coefficients (one array of c* per eigentrajectory) and time basis.
+///
+/// The thesis runs a plain PCA over the eigentrajectories. That spends the c* components on
+/// every Eⱼₕ alike, although the last components of a cluster barely move the mesh. Here row
+/// i = (j, h) is weighted by sᵢ = ‖w_·h‖ over cluster j's vertices: within a cluster the
+/// local-PCA weight columns are orthogonal, so the position error of an eigentrajectory error
+/// ΔEⱼₕ is Σₕ ‖w_·h‖²‖ΔEⱼₕ‖², and the PCA of the rows sᵢ(Eᵢ − μ) minimises exactly that
+/// (before quantization). μ is the s-weighted mean, which makes the weighted rows centred,
+/// so `Pca::fit`'s own centring leaves them alone. The coefficients are the projections of
+/// the unweighted Eᵢ − μ. When every sᵢ is 0 (a static clip) the rows are weighted equally.
 fn time_pca(
     rows: &[Vec<f64>],
+    importance: &[f64],
     d: usize,
     cs: usize,
     qc: u8,
     qw: u8,
 ) -> Result<(Vec<Quantized>, TimeBasis)> {
-    let data = Mat::from_fn(rows.len(), d, |i, t| rows[i][t]);
+    let total: f64 = importance.iter().sum();
+    let s: Vec<f64> = if total > 0.0 && total.is_finite() {
+        importance.to_vec()
+    } else {
+        vec![1.0; rows.len()]
+    };
+    let total: f64 = s.iter().sum();
+    let mut mean = vec![0f64; d];
+    for (r, &si) in rows.iter().zip(&s) {
+        for (m, x) in mean.iter_mut().zip(r) {
+            *m += si * x / total;
+        }
+    }
+    let data = Mat::from_fn(rows.len(), d, |i, t| s[i] * (rows[i][t] - mean[t]));
     let cs = cs.min(rows.len()).min(d).max(1);
     let pca = Pca::fit(
         data.as_ref(),
@@ -259,15 +301,14 @@ fn time_pca(
     // Rank-deficient data (e.g. a static clip) can give fewer axes than asked: pad with zero
     // axes so that the stored c* is the requested one.
     let got = pca.n_components();
-    let axis = |s: usize| -> Vec<f64> {
-        if s < got {
-            pca.component(s).to_vec()
+    let axis = |k: usize| -> Vec<f64> {
+        if k < got {
+            pca.component(k).to_vec()
         } else {
             vec![0.0; d]
         }
     };
     let axes: Vec<Vec<f64>> = (0..cs).map(axis).collect();
-    let mean = pca.mean();
     let coef = rows
         .iter()
         .map(|r| {
@@ -275,7 +316,7 @@ fn time_pca(
                 .iter()
                 .map(|b| {
                     r.iter()
-                        .zip(mean)
+                        .zip(&mean)
                         .zip(b)
                         .map(|((x, m), e)| (x - m) * e)
                         .sum()
@@ -285,8 +326,26 @@ fn time_pca(
         })
         .collect();
     let time = TimeBasis {
-        mean: Quantized::new(mean, qw),
+        mean: Quantized::new(&mean, qw),
         basis: axes.iter().map(|b| Quantized::new(b, qw)).collect(),
     };
     Ok((coef, time))
+}
+
+/// The triangles as the file will hold them: ordered for the vertex cache
+/// (`meshopt::optimize_vertex_cache`, which the index codec compresses best) and passed through
+/// the codec once, so that each triangle has the corner rotation a decoder returns and
+/// `Compressed::from_bytes(&c.to_bytes()) == c`.
+fn coded_triangles(triangles: &[[u32; 3]], v: usize) -> Result<Vec<[u32; 3]>> {
+    if triangles.is_empty() {
+        return Ok(Vec::new());
+    }
+    let flat: Vec<u32> = triangles.iter().flatten().copied().collect();
+    let ordered = meshopt::optimize_vertex_cache(&flat, v);
+    let ordered: Vec<[u32; 3]> = ordered
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]])
+        .collect();
+    let bytes = super::format::encode_triangles(&ordered, v);
+    super::format::decode_triangles(&bytes, ordered.len(), v)
 }

@@ -95,7 +95,7 @@ impl Decoder {
                     for j in 0..k {
                         let dst = &mut rows[(t * k + j) * stride..][..stride];
                         for a in 0..3 {
-                            dst[a] = means[j][3 * t + a] as f32;
+                            dst[a] = means[3 * j + a][t] as f32;
                             for h in 0..c {
                                 dst[3 * (h + 1) + a] = eigen[j * c + h][3 * t + a] as f32;
                             }
@@ -110,7 +110,7 @@ impl Decoder {
                 for t in 0..f {
                     for j in 0..k {
                         for a in 0..3 {
-                            m[(t * k + j) * 3 + a] = means[j][3 * t + a] as f32;
+                            m[(t * k + j) * 3 + a] = means[3 * j + a][t] as f32;
                         }
                     }
                 }

@@ -27,3 +27,17 @@ pub fn rigid_parts(parts: usize, per_part: usize, frames: usize) -> Vec<Vec<Vec3
         })
         .collect()
 }
+
+/// Triangles rotated so that the smallest index comes first (winding kept) and sorted: equal
+/// for two lists holding the same triangles in any order and rotation.
+pub fn canonical_triangles(tris: &[[u32; 3]]) -> Vec<[u32; 3]> {
+    let mut out: Vec<[u32; 3]> = tris
+        .iter()
+        .map(|t| {
+            let r = (0..3).min_by_key(|&i| t[i]).unwrap();
+            [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
