@@ -1,4 +1,5 @@
-//! Procedural data for demos and tests: a cloth drape animation and HDR skies with a sun.
+//! Procedural data for demos and tests: a cloth drape animation, HDR skies with a sun, and
+//! a woven-cloth BTF.
 //!
 //! Nothing here reads a file; everything is deterministic for its parameters (including
 //! the seed). Output is plain data (glam vectors, `Vec`s), not other project crates' types.
@@ -17,10 +18,18 @@
 //!   limb-darkened sun disc a chosen multiple — default 5·10⁴ — brighter than the mean sky,
 //!   power-conserving at any resolution) in the shared [`latlong`] convention used by
 //!   `lightsphere` (thesis §4.4.5 lights the cloth with such maps).
+//! * [`WovenBtf`] ([`btf`]): a procedural bidirectional texture function of plain-weave
+//!   cloth, the stand-in for the measured Bonn UBO2003 BTFs (thesis §5.3): an analytic,
+//!   tileable height field of interlaced yarns, ray-marched per view with the images
+//!   registered to the frontal view's plane (§5.3.3), and lit with cast shadows. It shows
+//!   what a BTF adds to a texture — parallax and masking under oblique views, yarns
+//!   shadowing each other under grazing light. [`WovenBtf::view`] traces one view,
+//!   [`ViewHits::shade`] lights it; 81 × 81 images of 64² take a few seconds.
 //!
 //! No seed section specifies this crate, so no seed equation is implemented here; the
 //! methods are cited in each module (Macklin et al. 2016/2019 for XPBD, Bergou et al. 2006
-//! for bending, Kim et al. 2012 for tethers, Preetham et al. 1999 for the sky).
+//! for bending, Kim et al. 2012 for tethers, Preetham et al. 1999 for the sky, the thesis's
+//! §5.3 acquisition set-up for the BTF's sampling and registration).
 //!
 //! # Examples
 //! ```
@@ -36,15 +45,24 @@
 //! let image = synth::sky(&SkyParams { width: 128, height: 64, ..Default::default() })?;
 //! let brightest = image.texels.iter().map(|t| t[1]).fold(0.0f32, f32::max);
 //! assert!(brightest > 100.0 * image.texel(0, 0)[1]); // the sun
+//!
+//! let btf = synth::WovenBtf::new(&synth::WovenBtfParams { res: 8, ..Default::default() })?;
+//! let image = btf.view(glam::Vec3::Z)?.shade(glam::Vec3::Z); // frontal view and light
+//! assert_eq!(image.len(), 8 * 8);
 //! # Ok::<(), synth::SynthError>(())
 //! ```
 
+pub mod btf;
 mod cloth;
 mod error;
 pub mod latlong;
 mod rng;
 mod sky;
 
+pub use btf::{
+    MAX_SUPERSAMPLE, MAX_WOVEN_SAMPLES, MAX_YARNS, MIN_VIEW_ELEVATION_DEG, SurfacePoint, ViewHits,
+    WovenBtf, WovenBtfParams, Yarn,
+};
 pub use cloth::{
     ClothAnimation, ClothParams, MAX_GRID, MAX_OBSTACLE_DETAIL, MAX_POSITIONS,
     MAX_SELF_COLLISION_DISTANCE, MAX_SUBSTEPS, Obstacle, obstacle_mesh, simulate_cloth,

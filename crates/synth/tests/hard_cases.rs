@@ -1,10 +1,11 @@
 //! Named adversarial cases: degenerate sizes, bad starts, extreme knobs, huge offsets,
-//! invalid parameters. Results must be finite, deterministic and within stated error.
+//! grazing directions, invalid parameters. Results must be finite, deterministic and within stated error.
 
 use glam::Vec3;
 use std::f64::consts::{PI, TAU};
 use synth::{
-    ClothAnimation, ClothParams, Obstacle, SkyParams, SynthError, simulate_cloth, sky, sun_radiance,
+    ClothAnimation, ClothParams, Obstacle, SkyParams, SynthError, WovenBtf, WovenBtfParams,
+    simulate_cloth, sky, sun_radiance,
 };
 
 /// Small, quick variant of the default drape.
@@ -518,5 +519,256 @@ fn invalid_sky_parameters_are_rejected_with_the_field_name() {
     assert!(
         matches!(error, SynthError::TooLarge { .. }) && error.to_string().contains("texels"),
         "{error}"
+    );
+}
+
+// ------------------------------------------------------------------ woven-cloth BTF
+
+/// d(θ, φ) = (sin θ cos φ, sin θ sin φ, cos θ), angles in degrees.
+fn woven_dir(theta_deg: f64, phi_deg: f64) -> Vec3 {
+    let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
+    glam::DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos()).as_vec3()
+}
+
+fn woven(params: WovenBtfParams) -> WovenBtf {
+    WovenBtf::new(&params).expect("valid parameters")
+}
+
+/// Every channel finite and in `[0, bound]`.
+#[track_caller]
+fn assert_radiance_in(image: &[[f32; 3]], bound: f32) {
+    for (i, texel) in image.iter().enumerate() {
+        for c in texel {
+            assert!(c.is_finite() && (0.0..=bound).contains(c), "texel {i}: {c}");
+        }
+    }
+}
+
+/// The largest radiance the model can produce (see `synth::btf`).
+fn radiance_bound(params: &WovenBtfParams) -> f32 {
+    let albedo = params
+        .warp_albedo
+        .max_element()
+        .max(params.weft_albedo.max_element())
+        * (1.0 + params.albedo_variation);
+    params.diffuse_weight * albedo.max(params.gap_albedo.max_element())
+        + params.glossy_weight * (params.glossy_exponent + 8.0) / 8.0
+        + 1e-6
+}
+
+#[test]
+fn woven_one_texel_one_sample() {
+    let params = WovenBtfParams {
+        res: 1,
+        supersample: 1,
+        ..Default::default()
+    };
+    let btf = woven(params);
+    for view in [woven_dir(0.0, 0.0), woven_dir(85.0, 15.0)] {
+        let hits = btf.view(view).expect("view");
+        assert_eq!(hits.hits().len(), 1);
+        for light in [woven_dir(0.0, 0.0), woven_dir(85.0, 200.0)] {
+            let image = hits.shade(light);
+            assert_eq!(image.len(), 1);
+            assert_radiance_in(&image, radiance_bound(&params));
+            assert_eq!(image, btf.view(view).expect("view").shade(light));
+        }
+    }
+}
+
+#[test]
+fn woven_many_thin_yarns_on_a_coarse_image() {
+    // 256 yarns each way on 8² × 2² sub-samples: far less than a sub-sample per yarn (the
+    // shadow lattice would be too coarse to tell the yarns apart, so every hit is traced).
+    let params = WovenBtfParams {
+        res: 8,
+        warp_count: 256,
+        weft_count: 256,
+        ..Default::default()
+    };
+    let btf = woven(params);
+    let light = woven_dir(80.0, 30.0);
+    for view in [woven_dir(0.0, 0.0), woven_dir(68.0, 144.0)] {
+        let hits = btf.view(view).expect("view");
+        assert_radiance_in(&hits.shade(light), radiance_bound(&params));
+    }
+    // Seen from above, the grazing light still leaves a share of the surface in shadow.
+    let hits = btf.view(woven_dir(0.0, 0.0)).expect("view");
+    let shadowed = hits.cast_shadows(light).iter().filter(|&&s| s).count();
+    assert!(
+        shadowed * 10 > hits.hits().len(),
+        "only {shadowed} in cast shadow"
+    );
+}
+
+#[test]
+fn woven_no_gaps_and_no_crimp() {
+    // Yarns as wide as their pitch leave no gap; without crimp warp and weft tie at every
+    // crossing (the warp wins ties).
+    let params = WovenBtfParams {
+        res: 16,
+        yarn_width: 1.0,
+        crimp: 0.0,
+        ..Default::default()
+    };
+    let btf = woven(params);
+    for view in [
+        woven_dir(0.0, 0.0),
+        woven_dir(51.0, 20.0),
+        woven_dir(85.0, 290.0),
+    ] {
+        let hits = btf.view(view).expect("view");
+        assert!(
+            hits.hits().iter().all(|h| h.yarn != synth::Yarn::Gap),
+            "{view}"
+        );
+        for light in [woven_dir(0.0, 0.0), woven_dir(75.0, 45.0)] {
+            assert_radiance_in(&hits.shade(light), radiance_bound(&params));
+        }
+    }
+    let crossing = btf.surface(0.125, 0.125);
+    assert_eq!(crossing.yarn, synth::Yarn::Warp(0));
+}
+
+#[test]
+fn woven_view_at_the_minimum_elevation() {
+    let params = WovenBtfParams {
+        res: 16,
+        ..Default::default()
+    };
+    let btf = woven(params);
+    let (floor, top) = btf.height_range();
+    // 1.2° above the surface: each ray travels up to 11 tiles before it meets the floor.
+    let hits = btf.view(woven_dir(88.8, 37.0)).expect("view");
+    for hit in hits.hits() {
+        assert!(hit.position.is_finite() && hit.normal.is_finite());
+        assert!(hit.position.z >= floor && hit.position.z <= top + 1e-6);
+        // So grazing a view only sees the tops of the yarns.
+        assert!(hit.position.z > 0.0, "{hit:?}");
+    }
+    assert_radiance_in(&hits.shade(woven_dir(30.0, 0.0)), radiance_bound(&params));
+}
+
+#[test]
+fn woven_light_grazing_the_horizon_stays_finite_and_dark() {
+    let params = WovenBtfParams {
+        res: 16,
+        ..Default::default()
+    };
+    let btf = woven(params);
+    for view in [woven_dir(0.0, 0.0), woven_dir(60.0, 100.0)] {
+        let hits = btf.view(view).expect("view");
+        for theta in [89.0, 89.9, 89.999] {
+            let image = hits.shade(woven_dir(theta, 10.0));
+            assert_radiance_in(&image, radiance_bound(&params));
+            let mean = image.iter().flatten().sum::<f32>() / (3 * image.len()) as f32;
+            assert!(mean < 0.02, "θ {theta}: mean {mean}");
+        }
+        // Exactly on the horizon: black, by definition.
+        let horizon = hits.shade(Vec3::new(0.6, 0.8, 0.0));
+        assert!(horizon.iter().all(|t| *t == [0.0; 3]));
+    }
+}
+
+#[test]
+fn woven_extreme_gloss_stays_in_range() {
+    for (glossy_weight, glossy_exponent) in [(1.0, 1.0e4), (1.0, 31.5), (0.5, 1.0), (1.0, 2.5)] {
+        let params = WovenBtfParams {
+            res: 12,
+            glossy_weight,
+            glossy_exponent,
+            ..Default::default()
+        };
+        let btf = woven(params);
+        for view in [woven_dir(0.0, 0.0), woven_dir(45.0, 0.0)] {
+            let hits = btf.view(view).expect("view");
+            for light in [
+                woven_dir(0.0, 0.0),
+                woven_dir(45.0, 180.0),
+                woven_dir(80.0, 90.0),
+            ] {
+                assert_radiance_in(&hits.shade(light), radiance_bound(&params));
+            }
+        }
+    }
+}
+
+#[test]
+fn woven_directions_need_not_be_unit() {
+    let btf = woven(WovenBtfParams {
+        res: 12,
+        ..Default::default()
+    });
+    let (view, light) = (woven_dir(40.0, 75.0), woven_dir(70.0, 300.0));
+    // Scaling by a power of two normalises back to the same bits.
+    let hits = btf.view(view).expect("view");
+    let scaled = btf.view(4.0 * view).expect("view");
+    assert_eq!(hits.hits(), scaled.hits());
+    assert_eq!(hits.shade(light), scaled.shade(0.25 * light));
+    // Other lengths give the same image up to rounding of the direction.
+    let rescaled = hits.shade(3.0 * light);
+    let worst = hits
+        .shade(light)
+        .iter()
+        .zip(&rescaled)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs()))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 0.05, "{worst}");
+}
+
+#[test]
+fn woven_more_lights_than_the_table_cache_holds_is_still_deterministic() {
+    let params = WovenBtfParams {
+        res: 4,
+        ..Default::default()
+    };
+    let btf = woven(params);
+    let hits = btf.view(woven_dir(51.0, 60.0)).expect("view");
+    let probe = woven_dir(68.0, 18.0);
+    let first = hits.shade(probe);
+    // 300 distinct lights: the shadow-table cache (128) overflows.
+    for k in 0..300 {
+        let light = woven_dir(1.0 + 0.29 * f64::from(k), 1.7 * f64::from(k));
+        assert_radiance_in(&hits.shade(light), radiance_bound(&params));
+    }
+    assert_eq!(hits.shade(probe), first);
+    assert_eq!(
+        woven(params)
+            .view(woven_dir(51.0, 60.0))
+            .expect("view")
+            .shade(probe),
+        first
+    );
+}
+
+#[test]
+fn woven_surface_at_huge_tile_offsets() {
+    let btf = woven(WovenBtfParams {
+        res: 8,
+        ..Default::default()
+    });
+    let (mut same_yarn, mut worst_smooth) = (0, 0.0f32);
+    let n = 2000;
+    for k in 0..n {
+        let (x, y) = ((k as f32 * 0.618_034) % 1.0, (k as f32 * 0.754_877_7) % 1.0);
+        let near = btf.surface(x, y);
+        // 1000 tiles away f32 keeps 6·10⁻⁵ of a tile: the point moves by up to that much.
+        let far = btf.surface(x + 1000.0, y - 1000.0);
+        assert!(far.position.is_finite() && far.normal.is_finite());
+        assert!(far.position.x < 1.0 && far.position.y < 1.0);
+        if far.yarn == near.yarn {
+            same_yarn += 1;
+            if near.normal.z > 0.5 {
+                worst_smooth = worst_smooth.max((far.position.z - near.position.z).abs());
+            }
+        }
+    }
+    assert!(
+        same_yarn * 100 >= 99 * n,
+        "{same_yarn} of {n} on the same yarn"
+    );
+    assert!(
+        worst_smooth < 2e-4,
+        "height off by {worst_smooth} 1000 tiles away"
     );
 }
