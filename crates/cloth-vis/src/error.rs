@@ -51,6 +51,11 @@ pub enum Error {
     /// The visibility engine failed.
     #[error(transparent)]
     Visibility(#[from] occlusion_gpu::OcclusionError),
+    /// A BTF folder or `.btfpca` file is invalid, or BTF compression failed (the message
+    /// names the file and element).
+    /// (Boxed: `BtfError` is large, and every `Result` of the facade would carry its size.)
+    #[error(transparent)]
+    Btf(Box<btf::BtfError>),
     /// Procedural data could not be made.
     #[error(transparent)]
     Synth(#[from] synth::SynthError),
@@ -69,4 +74,10 @@ pub enum Error {
         /// Frames available.
         count: usize,
     },
+}
+
+impl From<btf::BtfError> for Error {
+    fn from(e: btf::BtfError) -> Self {
+        Self::Btf(Box::new(e))
+    }
 }

@@ -43,6 +43,12 @@ enum Command {
         #[command(subcommand)]
         command: AnimCommand,
     },
+    /// Measured materials (BTFs, thesis §5.3–5.5): a synthetic woven BTF, per-view PCA
+    /// compression, error statistics.
+    Btf {
+        #[command(subcommand)]
+        command: BtfCommand,
+    },
     /// Visibility matrix M and ambient term a_i of a mesh or an animation (paper 000).
     Visibility {
         /// A mesh (.ply .obj .gltf .glb) or an animation (folder of numbered .obj, .npy, .glb).
@@ -127,6 +133,57 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+#[derive(Subcommand)]
+enum BtfCommand {
+    /// Write the synthetic woven-cloth BTF as 81 × 81 PNGs named as the Bonn UBO2003 archives
+    /// (tl… pl… tv… pv….png) into a new folder.
+    Synth {
+        /// Texels per image side (the thesis's normtextures are 256).
+        #[arg(long, default_value_t = synth::WovenBtfParams::default().res)]
+        res: usize,
+        /// Measured directions: h1 (θ up to 85°) or h2 (θ up to 75°), Table 5.1.
+        #[arg(long, default_value = "h1", value_parser = parse_sampling)]
+        sampling: btf::Sampling,
+        /// Rays per texel side (anti-aliasing of the mesostructure).
+        #[arg(long, default_value_t = synth::WovenBtfParams::default().supersample)]
+        supersample: usize,
+        /// Output folder (must not exist, or be empty).
+        #[arg(long)]
+        out: PathBuf,
+        /// Hide the progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Compress a BTF folder by per-view PCA (§5.4) into a .btfpca file.
+    Compress {
+        /// The folder of 81 × 81 images (UBO2003 names; PNG/JPEG sRGB or EXR linear).
+        dir: PathBuf,
+        /// c: eigen-normtextures per view slot (clamped to each slot's rank, at most 80).
+        #[arg(long, default_value_t = btf::DEFAULT_COMPONENTS)]
+        components: usize,
+        /// Bits of the eigen-normtextures: u8 (the thesis's), u16 or f32.
+        #[arg(long, default_value = "u8", value_parser = parse_storage)]
+        storage: btf::Storage,
+        /// Bits of the mean normtextures: u8, u16 (default) or f32.
+        #[arg(long, default_value = "u16", value_parser = parse_storage)]
+        mean_storage: btf::Storage,
+        /// Output: FILE.btfpca.
+        #[arg(long)]
+        out: PathBuf,
+        /// Hide the progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Compare a .btfpca with its folder: sizes, RMS error (8-bit sRGB) and PSNR over every
+    /// image.
+    Stats {
+        /// The BTF folder.
+        dir: PathBuf,
+        /// The .btfpca file.
+        file: PathBuf,
+    },
 }
 
 #[derive(Subcommand)]
@@ -434,6 +491,60 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 cloth_vis::anim_compress_cmd::run_stats_with_pictures(&request, gpu.as_ref())?;
             writeln!(std::io::stdout().lock(), "{}", summary.line())?;
         }
+        Command::Btf {
+            command:
+                BtfCommand::Synth {
+                    res,
+                    sampling,
+                    supersample,
+                    out,
+                    quiet,
+                },
+        } => {
+            let request = cloth_vis::btf_cmd::SynthRequest {
+                params: synth::WovenBtfParams {
+                    res,
+                    supersample,
+                    ..Default::default()
+                },
+                sampling,
+                out,
+                progress: !quiet,
+            };
+            let summary = cloth_vis::btf_cmd::run_synth(&request)?;
+            writeln!(std::io::stdout().lock(), "{}", summary.line())?;
+        }
+        Command::Btf {
+            command:
+                BtfCommand::Compress {
+                    dir,
+                    components,
+                    storage,
+                    mean_storage,
+                    out,
+                    quiet,
+                },
+        } => {
+            let request = cloth_vis::btf_cmd::CompressRequest {
+                dir,
+                params: btf::BtfPcaParams {
+                    components,
+                    storage,
+                    mean_storage,
+                    ..Default::default()
+                },
+                out,
+                progress: !quiet,
+            };
+            let summary = cloth_vis::btf_cmd::run_compress(&request)?;
+            writeln!(std::io::stdout().lock(), "{}", summary.line())?;
+        }
+        Command::Btf {
+            command: BtfCommand::Stats { dir, file },
+        } => {
+            let summary = cloth_vis::btf_cmd::run_stats(&dir, &file, false)?;
+            writeln!(std::io::stdout().lock(), "{}", summary.line())?;
+        }
         Command::Visibility {
             input,
             level,
@@ -515,6 +626,23 @@ fn parse_range(text: &str) -> Result<(usize, usize), String> {
 }
 
 /// Parse `WxH` (e.g. `640x480`).
+fn parse_sampling(text: &str) -> Result<btf::Sampling, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "h1" => Ok(btf::Sampling::H1),
+        "h2" => Ok(btf::Sampling::H2),
+        _ => Err(format!("{text:?}: the samplings are h1 and h2 (Table 5.1)")),
+    }
+}
+
+fn parse_storage(text: &str) -> Result<btf::Storage, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "u8" => Ok(btf::Storage::U8),
+        "u16" => Ok(btf::Storage::U16),
+        "f32" => Ok(btf::Storage::F32),
+        _ => Err(format!("{text:?}: the storages are u8, u16 and f32")),
+    }
+}
+
 fn parse_size(text: &str) -> Result<[u32; 2], String> {
     let (w, h) = text
         .split_once(['x', 'X'])

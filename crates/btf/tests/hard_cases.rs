@@ -1,0 +1,339 @@
+//! Named adversarial cases of light/view interpolation and per-view PCA (DESIGN.md, "Hard
+//! cases stay numerically stable").
+
+mod common;
+
+use btf::{BtfPca, BtfPcaParams, DIRECTIONS, Sampling, Storage, ViewSlot};
+use common::{analytic, analytic_pca, analytic_slot, assert_close};
+use glam::Vec3;
+
+const RES: usize = 16;
+
+fn exact_params(components: usize) -> BtfPcaParams {
+    BtfPcaParams {
+        components,
+        storage: Storage::F32,
+        mean_storage: Storage::F32,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn light_exactly_at_a_measured_direction() {
+    for s in Sampling::ALL {
+        for i in 0..DIRECTIONS {
+            let w = s.light_weights(s.vector(i));
+            assert_eq!(w.len(), 1, "{s} light {i}: {w:?}");
+            assert_eq!((w.indices[0], w.weights[0]), (i, 1.0), "{s} light {i}");
+            let (t, p) = s.dir(i);
+            let w = s.light_weights_deg(f64::from(t), f64::from(p) + 360.0);
+            assert_eq!((w.len(), w.indices[0]), (1, i), "{s} light {i} (φ + 360°)");
+            let v = s.view_weights(s.vector(i));
+            assert_eq!((v.len(), v.indices[0], v.weights[0]), (1, i, 1.0));
+        }
+    }
+    // The reconstruction equals the stored image, and the stored image its input.
+    let s = Sampling::H1;
+    let pca = analytic_pca(s, RES, &exact_params(80));
+    for (j, i) in [(0, 0), (5, 17), (40, 80), (80, 36)] {
+        let from_dir = pca.image_from_gamma(j, &pca.gamma(j, s.vector(i)));
+        assert_eq!(from_dir, pca.image(j, i), "slot {j}, light {i}");
+        for (t, rgb) in from_dir.iter().enumerate() {
+            let want = analytic(s, j, i, t % RES, t / RES, RES);
+            for c in 0..3 {
+                assert_close(f64::from(rgb[c]), f64::from(want[c]), 1e-4, "texel");
+            }
+        }
+        // eval at a texel centre of view slot j and light i gives the same texel.
+        let (u, v) = ((3.5 / RES as f32), (7.5 / RES as f32));
+        assert_eq!(
+            pca.eval(s.vector(j), s.vector(i), u, v),
+            from_dir[7 * RES + 3]
+        );
+    }
+}
+
+#[test]
+fn light_at_the_horizon_and_below() {
+    for s in Sampling::ALL {
+        let last = f64::from(s.ring_thetas()[5]);
+        for phi in [0.0, 7.5, 100.0, 359.9] {
+            assert!(s.light_weights_deg(90.0, phi).is_empty());
+            assert!(s.light_weights_deg(120.0, phi).is_empty());
+            assert!(s.light_weights_deg(180.0, phi).is_empty());
+            assert_close(
+                f64::from(s.light_weights_deg(last, phi).sum()),
+                1.0,
+                1e-6,
+                "last ring",
+            );
+            // Linear fade between the last ring and the horizon.
+            let theta = 0.5 * (last + 90.0);
+            let w = s.light_weights_deg(theta, phi);
+            assert_close(f64::from(w.sum()), 0.5, 1e-6, "half-way to the horizon");
+            assert!(w.iter().all(|(i, _)| s.ring_of(i) == 5));
+        }
+        for dir in [
+            Vec3::X,
+            Vec3::new(0.3, -0.7, 0.0),
+            Vec3::new(1.0, 0.0, -1e-6),
+            -Vec3::Z,
+            Vec3::ZERO,
+            Vec3::new(f32::NAN, 0.0, 1.0),
+        ] {
+            assert!(s.light_weights(dir).is_empty(), "{s} {dir}");
+        }
+    }
+    let s = Sampling::H2;
+    let pca = analytic_pca(s, 4, &BtfPcaParams::default());
+    for light in [Vec3::X, Vec3::new(0.2, 0.1, -0.5), -Vec3::Z] {
+        assert!(pca.gamma(3, light).iter().all(|&g| g == 0.0));
+        assert_eq!(pca.eval(Vec3::Z, light, 0.5, 0.5), [0.0; 3]);
+    }
+}
+
+#[test]
+fn view_at_theta_zero_phi_undefined() {
+    for s in Sampling::ALL {
+        for dir in [
+            Vec3::Z,
+            Vec3::new(-0.0, 0.0, 1.0),
+            Vec3::new(0.0, -0.0, 2.5),
+        ] {
+            let w = s.view_weights(dir);
+            assert_eq!((w.len(), w.indices[0], w.weights[0]), (1, 0, 1.0), "{dir}");
+            let l = s.light_weights(dir);
+            assert_eq!((l.len(), l.indices[0], l.weights[0]), (1, 0, 1.0), "{dir}");
+        }
+        for phi in [0.0, 123.0, f64::NAN] {
+            let w = s.view_weights_deg(0.0, phi);
+            assert_eq!((w.indices[0], w.weights[0]), (0, 1.0), "φ = {phi}");
+        }
+        // Tiny tilts in any azimuth: finite weights near the pole, summing to 1.
+        for k in 0..16 {
+            let a = k as f32 * 0.4;
+            let dir = Vec3::new(1e-7 * a.cos(), 1e-7 * a.sin(), 1.0);
+            let w = s.view_weights(dir);
+            assert!(w.weights.iter().all(|x| x.is_finite()));
+            assert_close(f64::from(w.sum()), 1.0, 1e-6, "near-pole sum");
+            assert!(w.weights[0] > 0.999 && w.indices[0] == 0);
+        }
+        // Degenerate view directions count as the normal; grazing views clamp to the last ring.
+        assert_eq!(s.view_weights(Vec3::ZERO).indices[0], 0);
+        let g = s.view_weights(Vec3::new(0.0, 1.0, -0.3));
+        assert_close(f64::from(g.sum()), 1.0, 1e-6, "view below the horizon");
+        assert!(g.iter().all(|(i, _)| s.ring_of(i) == 5));
+    }
+    let s = Sampling::H1;
+    let pca = analytic_pca(s, 4, &BtfPcaParams::default());
+    let rgb = pca.eval(Vec3::Z, Vec3::new(0.3, 0.2, 0.9), 0.1, 0.9);
+    assert!(rgb.iter().all(|c| c.is_finite() && *c > 0.0), "{rgb:?}");
+}
+
+#[test]
+fn components_larger_than_81() {
+    let s = Sampling::H2;
+    let params = BtfPcaParams {
+        components: 500,
+        ..Default::default()
+    };
+    let (pca, report) =
+        BtfPca::compress_with(s, 8, 8, &params, |j| Ok(analytic_slot(s, j, 8)), None)
+            .expect("c > 81 is clamped, not an error");
+    assert!(report.clamped());
+    assert_eq!(report.requested, 500);
+    for (j, slot) in pca.slots().iter().enumerate() {
+        assert!(slot.components() <= btf::MAX_COMPONENTS);
+        assert_eq!(slot.components(), slot.rank(), "slot {j} keeps all it has");
+        assert_eq!(report.slots[j].components, slot.components());
+    }
+    assert_eq!(BtfPca::from_bytes(&pca.to_bytes()).unwrap(), pca);
+}
+
+#[test]
+fn view_slot_whose_images_are_all_identical() {
+    let s = Sampling::H1;
+    let res = 8;
+    let constant = |j: usize| {
+        let one: Vec<f32> = (0..3 * res * res).map(|t| (t % 7) as f32 * 0.1).collect();
+        ViewSlot::new(j, res, res, one.repeat(DIRECTIONS))
+    };
+    let load = |j: usize| {
+        if j == 7 {
+            constant(j)
+        } else {
+            Ok(analytic_slot(s, j, res))
+        }
+    };
+    let (pca, report) =
+        BtfPca::compress_with(s, res, res, &BtfPcaParams::default(), load, None).unwrap();
+    let slot = pca.slot(7);
+    assert_eq!((slot.components(), slot.rank()), (0, 0));
+    assert!(slot.eigenvalues().is_empty() && slot.weights().is_empty());
+    assert_eq!(report.slots[7].components, 0);
+    assert!(pca.slot(6).components() > 0);
+    let want = constant(7).unwrap();
+    for i in [0, 40, 80] {
+        for (t, rgb) in pca.image(7, i).iter().enumerate() {
+            for (c, &value) in rgb.iter().enumerate() {
+                // Mean stored in 16 bits over [0, 0.6].
+                assert_close(
+                    f64::from(value),
+                    f64::from(want.image(i)[3 * t + c]),
+                    1e-5,
+                    "mean",
+                );
+            }
+        }
+    }
+    let g = pca.gamma(7, Vec3::new(0.1, 0.2, 0.8));
+    assert_eq!(g.len(), 1);
+    assert!(
+        pca.eval(s.vector(7), Vec3::Z, 0.3, 0.3)
+            .iter()
+            .all(|c| c.is_finite())
+    );
+    assert_eq!(BtfPca::from_bytes(&pca.to_bytes()).unwrap(), pca);
+}
+
+/// A deterministic stream of numbers in [0, 1).
+fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn weights_sum_to_one_and_reproduce_linear_functions_in_a_ring_cell() {
+    let mut rnd = uniform(7);
+    for s in Sampling::ALL {
+        let thetas = s.ring_thetas().map(f64::from);
+        for _ in 0..2000 {
+            // Inside the rings (not the pole cell, where φ is undefined) and away from the φ
+            // wrap at 360°, which is not linear in φ.
+            let theta = thetas[1] + rnd() * (thetas[5] - thetas[1]);
+            let phi = rnd() * 300.0;
+            let (a, b, c) = (rnd() - 0.5, rnd() - 0.5, rnd());
+            let f = |t: f64, p: f64| a * t + b * p + c;
+            for (what, w) in [
+                ("light", s.light_weights_deg(theta, phi)),
+                ("view", s.view_weights_deg(theta, phi)),
+            ] {
+                assert_close(f64::from(w.sum()), 1.0, 1e-6, what);
+                assert!(w.len() <= 4 && w.weights.iter().all(|&x| x >= 0.0));
+                let interp: f64 = w
+                    .iter()
+                    .map(|(i, x)| {
+                        let (t, p) = s.dir(i);
+                        f64::from(x) * f(f64::from(t), f64::from(p))
+                    })
+                    .sum();
+                // Exact up to f32 weights and the snap onto measured angles (≤ 0.001°).
+                let tol = (a.abs() + b.abs()) * btf::ANGLE_SNAP_DEG + 1e-6 * 360.0;
+                assert_close(interp, f(theta, phi), tol, what);
+            }
+        }
+        // Everywhere on the hemisphere (pole cell and wrap included) the sum is 1.
+        for _ in 0..2000 {
+            let theta = rnd() * thetas[5];
+            let w = s.light_weights_deg(theta, rnd() * 720.0 - 360.0);
+            assert_close(f64::from(w.sum()), 1.0, 1e-6, "sum");
+        }
+    }
+}
+
+#[test]
+fn pca_with_all_components_reconstructs_within_the_8_bit_quantization_bound() {
+    let s = Sampling::H1;
+    let res = 12;
+    let params = BtfPcaParams {
+        components: 80,
+        storage: Storage::U8,
+        mean_storage: Storage::U8,
+        ..Default::default()
+    };
+    let pca = analytic_pca(s, res, &params);
+    let exact = analytic_pca(s, res, &exact_params(80));
+    for j in [0, 9, 44, 80] {
+        let slot = pca.slot(j);
+        let input = analytic_slot(s, j, res);
+        assert_eq!(slot.components(), slot.rank(), "all components kept");
+        for i in 0..DIRECTIONS {
+            // |error| ≤ Δ_0/2 + Σ_k |p_ik| Δ_k/2 (+ f32 rounding), per value.
+            let p = slot.light_weights(i);
+            let bound = 0.5 * slot.texture(0).step()
+                + p.iter()
+                    .enumerate()
+                    .map(|(k, w)| 0.5 * w.abs() * slot.texture(k + 1).step())
+                    .sum::<f32>()
+                + 1e-5;
+            let got = pca.image(j, i);
+            let got_exact = exact.image(j, i);
+            for (t, (q, e)) in got.iter().zip(&got_exact).enumerate() {
+                for c in 0..3 {
+                    let want = input.image(i)[3 * t + c];
+                    assert!(
+                        (q[c] - want).abs() <= bound,
+                        "slot {j} light {i}: {} > {bound}",
+                        (q[c] - want).abs()
+                    );
+                    assert_close(
+                        f64::from(e[c]),
+                        f64::from(want),
+                        2e-5,
+                        "f32 storage, all components",
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn texel_reconstruction_equals_direct_f64_evaluation_of_the_stored_pca() {
+    let s = Sampling::H2;
+    let res = 8;
+    let pca = analytic_pca(
+        s,
+        res,
+        &BtfPcaParams {
+            components: 6,
+            ..Default::default()
+        },
+    );
+    let mut rnd = uniform(3);
+    for _ in 0..200 {
+        let j = (rnd() * 81.0) as usize;
+        let light = Vec3::new(rnd() as f32 - 0.5, rnd() as f32 - 0.5, rnd() as f32 + 0.05);
+        let (x, y) = ((rnd() * res as f64) as usize, (rnd() * res as f64) as usize);
+        let gamma = pca.gamma(j, light);
+        // γ in f64 from the weights and τ (eq. 5.3).
+        let tau = s.light_weights(light);
+        let slot = pca.slot(j);
+        let mut gamma64 = vec![0.0f64; slot.components() + 1];
+        for (i, w) in tau.iter() {
+            gamma64[0] += f64::from(w);
+            for (k, p) in slot.light_weights(i).iter().enumerate() {
+                gamma64[k + 1] += f64::from(w) * f64::from(*p);
+            }
+        }
+        let got = pca.texel(j, &gamma, x, y);
+        let t = 3 * (y * res + x);
+        for (c, &got_c) in got.iter().enumerate() {
+            let mut want = 0.0f64;
+            let mut scale = 0.0f64;
+            for (k, g) in gamma64.iter().enumerate() {
+                let v = f64::from(slot.texture(k).get(t + c));
+                want += g * v;
+                scale += (g * v).abs();
+            }
+            assert_close(f64::from(got_c), want, 1e-5 * scale.max(1.0), "texel");
+        }
+        // The whole-image path gives the same texel, bit for bit.
+        assert_eq!(pca.image_from_gamma(j, &gamma)[y * res + x], got);
+    }
+}

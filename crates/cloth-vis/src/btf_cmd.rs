@@ -1,0 +1,353 @@
+//! `cloth-vis btf synth | compress | stats`: measured-material (BTF) data on files, through
+//! crate `btf` (thesis §5.3–5.5) and the woven-cloth generator of `synth`.
+//!
+//! - `synth` writes the synthetic woven-cloth BTF (`synth::WovenBtf`) as a folder of 81 × 81
+//!   8-bit sRGB PNGs named as the Bonn UBO2003 archives name them (`tl… pl… tv… pv….png`),
+//!   so that everything downstream reads it through the same loader as measured data. The
+//!   folder appears complete or not at all: it is written under a temporary name beside the
+//!   target and renamed at the end.
+//! - `compress` runs the per-view PCA (§5.4, eq. 5.1) slot by slot and writes a `.btfpca`.
+//! - `stats` compares a `.btfpca` with its folder: sizes, RMS error in 8-bit sRGB units and
+//!   PSNR over every image.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use btf::{BtfDir, BtfPca, BtfPcaParams, ErrorStats, Sampling};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::Error;
+
+/// What `cloth-vis btf synth` was asked to do.
+#[derive(Clone, Debug)]
+pub struct SynthRequest {
+    /// The generator's parameters (resolution, weave, colours, supersampling).
+    pub params: synth::WovenBtfParams,
+    /// The measured direction set, H1 or H2 (Table 5.1).
+    pub sampling: Sampling,
+    /// The folder to create; it must not exist or be empty.
+    pub out: PathBuf,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+}
+
+/// What `synth` wrote.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SynthSummary {
+    /// Texels per image side.
+    pub res: usize,
+    /// The sampling written.
+    pub sampling: Sampling,
+    /// Images written (81 × 81).
+    pub images: usize,
+    /// Bytes on disk.
+    pub bytes: u64,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+impl SynthSummary {
+    /// One line for the terminal.
+    pub fn line(&self) -> String {
+        format!(
+            "btf synth: {} images of {r}x{r} ({}), {:.1} MB of PNG, {:.1} s",
+            self.images,
+            self.sampling.name(),
+            self.bytes as f64 / 1e6,
+            self.seconds,
+            r = self.res
+        )
+    }
+}
+
+/// What `cloth-vis btf compress` was asked to do.
+#[derive(Clone, Debug)]
+pub struct CompressRequest {
+    /// The BTF folder.
+    pub dir: PathBuf,
+    /// c, storage of the eigen-normtextures and of the means.
+    pub params: BtfPcaParams,
+    /// The `.btfpca` file to write.
+    pub out: PathBuf,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+}
+
+/// What `compress` did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CompressSummary {
+    /// Texels per image (width × height).
+    pub size: (usize, usize),
+    /// The c asked for.
+    pub requested: usize,
+    /// The smallest and largest c_j kept (c is clamped to each slot's rank and to 80).
+    pub kept: (usize, usize),
+    /// Bytes of the images as 8-bit RGB (6,561 × 3wh, the thesis's "1,230 MB" at 256²).
+    pub raw_bytes: u64,
+    /// Bytes of the written file.
+    pub file_bytes: u64,
+    /// Wall-clock seconds of the compression (loading included).
+    pub seconds: f64,
+}
+
+impl CompressSummary {
+    /// One line for the terminal.
+    pub fn line(&self) -> String {
+        let clamp = if self.kept.0 < self.requested {
+            format!(" (c_j {}..={} kept: clamped to each slot's rank)", self.kept.0, self.kept.1)
+        } else {
+            String::new()
+        };
+        format!(
+            "btf compress: {}x{}, c = {}{clamp}: {:.1} MB of 8-bit images -> {:.1} MB ({:.2}:1) in {:.1} s",
+            self.size.0,
+            self.size.1,
+            self.requested,
+            self.raw_bytes as f64 / 1e6,
+            self.file_bytes as f64 / 1e6,
+            self.raw_bytes as f64 / self.file_bytes.max(1) as f64,
+            self.seconds
+        )
+    }
+}
+
+/// What `cloth-vis btf stats` measured.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StatsSummary {
+    /// Texels per image (width × height).
+    pub size: (usize, usize),
+    /// Components per slot, smallest and largest.
+    pub kept: (usize, usize),
+    /// Bytes of the images as 8-bit RGB.
+    pub raw_bytes: u64,
+    /// Bytes of the `.btfpca` file.
+    pub file_bytes: u64,
+    /// The error over every image.
+    pub error: ErrorStats,
+}
+
+impl StatsSummary {
+    /// One line for the terminal.
+    pub fn line(&self) -> String {
+        format!(
+            "btf stats: {}x{}, c_j {}..={}: {:.1} MB -> {:.1} MB ({:.2}:1); {} images: RMS {:.3} \
+             (8-bit sRGB), PSNR {:.2} dB, worst {:.0}",
+            self.size.0,
+            self.size.1,
+            self.kept.0,
+            self.kept.1,
+            self.raw_bytes as f64 / 1e6,
+            self.file_bytes as f64 / 1e6,
+            self.raw_bytes as f64 / self.file_bytes.max(1) as f64,
+            self.error.images,
+            self.error.rms_srgb8,
+            self.error.psnr_db,
+            self.error.max_abs_srgb8
+        )
+    }
+}
+
+fn request(path: &Path, message: String) -> Error {
+    Error::Request {
+        path: path.to_owned(),
+        message,
+    }
+}
+
+fn bar(show: bool, len: u64, message: &'static str) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len);
+    if let Ok(style) = ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} ({eta})") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(message);
+    bar
+}
+
+/// 8-bit RGB bytes of a full 81 × 81 BTF of w × h texels.
+fn raw_bytes(w: usize, h: usize) -> u64 {
+    (btf::DIRECTIONS * btf::DIRECTIONS * 3 * w * h) as u64
+}
+
+fn dir_bytes(dir: &Path) -> u64 {
+    std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok()?.metadata().ok())
+                .map(|m| m.len())
+                .sum()
+        })
+        .unwrap_or(0)
+}
+
+/// Runs `btf synth`: every view slot's primary hits once, then its 81 light images.
+///
+/// # Errors
+/// An `out` that exists and is not an empty folder (refused before any work); bad generator
+/// parameters ([`Error::Synth`]); write errors. On error nothing is left at `out`.
+pub fn run_synth(request_: &SynthRequest) -> Result<SynthSummary, Error> {
+    let out = &request_.out;
+    if out.exists() {
+        let empty = std::fs::read_dir(out)
+            .map(|mut d| d.next().is_none())
+            .unwrap_or(false);
+        if !empty {
+            return Err(request(
+                out,
+                "exists and is not an empty folder; choose a new folder for the BTF images"
+                    .to_owned(),
+            ));
+        }
+    }
+    let woven = synth::WovenBtf::new(&request_.params)?;
+    let start = Instant::now();
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).map_err(|e| Error::Io {
+        path: parent.to_owned(),
+        reason: format!("cannot create the folder: {e}"),
+    })?;
+    let name = out
+        .file_name()
+        .map_or_else(|| "btf".into(), |n| n.to_string_lossy().into_owned());
+    let temp = parent.join(format!(".{name}.partial-{}", std::process::id()));
+    let result = write_views(&woven, request_, &temp);
+    if let Err(e) = result {
+        let _ = std::fs::remove_dir_all(&temp);
+        return Err(e);
+    }
+    if out.exists() {
+        // An empty folder (checked above) gives way to the complete one.
+        let _ = std::fs::remove_dir(out);
+    }
+    std::fs::rename(&temp, out).map_err(|e| {
+        let _ = std::fs::remove_dir_all(&temp);
+        Error::Io {
+            path: out.clone(),
+            reason: format!("cannot move the finished folder into place: {e}"),
+        }
+    })?;
+    Ok(SynthSummary {
+        res: woven.res(),
+        sampling: request_.sampling,
+        images: btf::DIRECTIONS * btf::DIRECTIONS,
+        bytes: dir_bytes(out),
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+fn write_views(
+    woven: &synth::WovenBtf,
+    request_: &SynthRequest,
+    dir: &Path,
+) -> Result<(), Error> {
+    let s = request_.sampling;
+    let progress = bar(request_.progress, btf::DIRECTIONS as u64, "view slots");
+    for view in 0..btf::DIRECTIONS {
+        let hits = woven.view(s.vector(view))?;
+        btf::write_btf_view(dir, s, woven.res(), view, |light| {
+            hits.shade(s.vector(light))
+        })
+?;
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+    Ok(())
+}
+
+fn check_btfpca_out(out: &Path) -> Result<(), Error> {
+    let ok = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("btfpca"));
+    if ok {
+        Ok(())
+    } else {
+        Err(request(
+            out,
+            "the compressed BTF is written as .btfpca; name the output so".to_owned(),
+        ))
+    }
+}
+
+/// Runs `btf compress`.
+///
+/// # Errors
+/// An output not named `.btfpca` (refused before reading); folder errors (a missing pair,
+/// mismatched sizes, an unreadable name — the file is named); write errors. Nothing is
+/// written on error.
+pub fn run_compress(request_: &CompressRequest) -> Result<CompressSummary, Error> {
+    check_btfpca_out(&request_.out)?;
+    let dir = BtfDir::open(&request_.dir)?;
+    let progress = bar(request_.progress, btf::DIRECTIONS as u64, "view slots");
+    let tick = |_: usize, _: usize| progress.inc(1);
+    let (pca, report) = BtfPca::compress_with(
+        dir.sampling(),
+        dir.width(),
+        dir.height(),
+        &request_.params,
+        |j| dir.load_view(j),
+        Some(&tick),
+    )
+    ?;
+    progress.finish_and_clear();
+    pca.write(&request_.out)
+        ?;
+    let file_bytes = std::fs::metadata(&request_.out)
+        .map(|m| m.len())
+        .unwrap_or(0);
+    let kept = report.slots.iter().map(|s| s.components);
+    Ok(CompressSummary {
+        size: (dir.width(), dir.height()),
+        requested: report.requested,
+        kept: (kept.clone().min().unwrap_or(0), kept.max().unwrap_or(0)),
+        raw_bytes: raw_bytes(dir.width(), dir.height()),
+        file_bytes,
+        seconds: report.seconds,
+    })
+}
+
+/// Runs `btf stats`: the error of `file` against every image of `dir`.
+///
+/// # Errors
+/// Folder and file errors naming the file; a `.btfpca` of another size or sampling than the
+/// folder, naming both.
+pub fn run_stats(dir: &Path, file: &Path, progress: bool) -> Result<StatsSummary, Error> {
+    let pca = BtfPca::read(file)?;
+    let folder = BtfDir::open(dir)?;
+    let (a, b) = (
+        (folder.sampling(), folder.width(), folder.height()),
+        (pca.sampling(), pca.width(), pca.height()),
+    );
+    if a != b {
+        return Err(request(
+            file,
+            format!(
+                "holds a {} BTF of {}x{} but {} is {} of {}x{}; compare a .btfpca with the \
+                 folder it was compressed from",
+                b.0.name(),
+                b.1,
+                b.2,
+                dir.display(),
+                a.0.name(),
+                a.1,
+                a.2
+            ),
+        ));
+    }
+    let bar = bar(progress, 1, "comparing");
+    let error = pca.stats(&folder, None)?;
+    bar.finish_and_clear();
+    let kept = pca.slots().iter().map(|s| s.components());
+    Ok(StatsSummary {
+        size: (pca.width(), pca.height()),
+        kept: (kept.clone().min().unwrap_or(0), kept.max().unwrap_or(0)),
+        raw_bytes: raw_bytes(pca.width(), pca.height()),
+        file_bytes: std::fs::metadata(file).map(|m| m.len()).unwrap_or(0),
+        error,
+    })
+}

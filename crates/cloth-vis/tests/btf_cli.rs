@@ -1,0 +1,170 @@
+//! `cloth-vis btf synth | compress | stats` through the binary: the synthetic woven BTF at 64²
+//! (the CI size) written in the UBO2003 layout, compressed by per-view PCA and compared
+//! with its images; and refused input (a missing image, a wrong output name, a folder that is
+//! not empty, a `.btfpca` of another BTF) with the file named and nothing written.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use btf::{BtfDir, BtfPca, Sampling};
+
+fn cli(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cloth-vis"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn text(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn synth_compress_stats_round_trip_at_64() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("woven");
+    let out = cli(&["btf", "synth", "--res", "64", "--out", text(&dir), "--quiet"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("6561 images of 64x64 (H1)"), "{}", stdout(&out));
+    // The folder is a real UBO2003 folder: the loader finds every pair at 64².
+    let folder = BtfDir::open(&dir).unwrap();
+    assert_eq!(
+        (folder.sampling(), folder.width(), folder.height()),
+        (Sampling::H1, 64, 64)
+    );
+    assert!(dir.join("tl000 pl000 tv000 pv000.png").is_file());
+    // Nothing but the finished folder is left beside it.
+    let names: Vec<_> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("woven")]);
+
+    let file = tmp.path().join("woven.btfpca");
+    let out = cli(&[
+        "btf",
+        "compress",
+        text(&dir),
+        "--components",
+        "16",
+        "--out",
+        text(&file),
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = stdout(&out);
+    let raw = 81 * 81 * 3 * 64 * 64;
+    assert!(line.contains(&format!("{:.1} MB of 8-bit images", raw as f64 / 1e6)), "{line}");
+    let pca = BtfPca::read(&file).unwrap();
+    assert!(pca.slots().iter().all(|s| s.components() == 16));
+    let size = std::fs::metadata(&file).unwrap().len();
+    assert!(line.contains(&format!("{:.1} MB (", size as f64 / 1e6)), "{line}");
+    // c = 16 of ≤ 80 components per slot, 8-bit bases: at least 4:1 over the 8-bit images.
+    assert!((raw as f64) / (size as f64) > 4.0, "{raw} / {size}");
+
+    let out = cli(&["btf", "stats", text(&dir), text(&file)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = stdout(&out);
+    // The binary prints what the library measures.
+    let error = pca.stats(&folder, None).unwrap();
+    assert_eq!(error.images, 6561);
+    assert!(
+        line.contains(&format!("RMS {:.3} (8-bit sRGB), PSNR {:.2} dB", error.rms_srgb8, error.psnr_db)),
+        "{line}"
+    );
+    // More components, less error (the per-view PCA is a truncation, eq. 5.1).
+    let file32 = tmp.path().join("woven32.btfpca");
+    let out = cli(&[
+        "btf",
+        "compress",
+        text(&dir),
+        "--components",
+        "32",
+        "--out",
+        text(&file32),
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let more = BtfPca::read(&file32).unwrap().stats(&folder, None).unwrap();
+    assert!(more.rms_srgb8 < error.rms_srgb8, "{more:?} vs {error:?}");
+}
+
+#[test]
+fn bad_input_is_refused_naming_the_file_and_nothing_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("w");
+    let out = cli(&["btf", "synth", "--res", "8", "--out", text(&dir), "--quiet"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+
+    // A synth into a folder that holds files is refused.
+    let out = cli(&["btf", "synth", "--res", "8", "--out", text(&dir), "--quiet"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains(text(&dir)), "{}", stderr(&out));
+    // Bad generator parameters name the field.
+    let out = cli(&[
+        "btf",
+        "synth",
+        "--res",
+        "0",
+        "--out",
+        text(&tmp.path().join("zero")),
+        "--quiet",
+    ]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("res"), "{}", stderr(&out));
+    assert!(!tmp.path().join("zero").exists());
+
+    // A wrong output name is refused before any work.
+    let bad = tmp.path().join("w.bin");
+    let out = cli(&["btf", "compress", text(&dir), "--out", text(&bad), "--quiet"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("w.bin"));
+    assert!(!bad.exists());
+
+    // A missing image: the error names the file that should be there.
+    let file = tmp.path().join("w.btfpca");
+    let missing = dir.join("tl015 pl060 tv030 pv090.png");
+    let missing = if missing.exists() {
+        missing
+    } else {
+        dir.join("tl017 pl060 tv034 pv090.png")
+    };
+    std::fs::remove_file(&missing).unwrap();
+    let out = cli(&["btf", "compress", text(&dir), "--out", text(&file), "--quiet"]);
+    assert!(!out.status.success());
+    let name = missing.file_name().unwrap().to_str().unwrap();
+    assert!(stderr(&out).contains(name), "{}", stderr(&out));
+    assert!(!file.exists());
+
+    // A .btfpca of another BTF is refused by stats, naming both.
+    let a = tmp.path().join("a");
+    let b = tmp.path().join("b");
+    for (d, res) in [(&a, "8"), (&b, "4")] {
+        let out = cli(&["btf", "synth", "--res", res, "--out", text(d), "--quiet"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let fa = tmp.path().join("a.btfpca");
+    let out = cli(&["btf", "compress", text(&a), "--out", text(&fa), "--quiet"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = cli(&["btf", "stats", text(&b), text(&fa)]);
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(e.contains("a.btfpca") && e.contains(text(&b)), "{e}");
+    // A corrupt .btfpca names the file.
+    let mut bytes = std::fs::read(&fa).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0xff;
+    let corrupt = tmp.path().join("c.btfpca");
+    std::fs::write(&corrupt, bytes).unwrap();
+    let out = cli(&["btf", "stats", text(&a), text(&corrupt)]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("c.btfpca"), "{}", stderr(&out));
+}
