@@ -15,7 +15,10 @@
 //!   stores them quantized in a validated `.btfpca` file ([`format`](mod@format));
 //! * reconstructs on the CPU ([`reconstruct`]): the per-slot coefficients γ (eq. 5.3), the
 //!   texel sum T_j = Σ_k γ_kj B_kj from B_0j, the mean (eq. 5.4), and view interpolation
-//!   (eq. 5.5); and measures the error against the measurement ([`BtfPca::stats`]).
+//!   (eq. 5.5); and measures the error against the measurement ([`BtfPca::stats`]);
+//! * renders a mesh textured by the compressed BTF under a point or directional light
+//!   ([`render`]: per-vertex γ and ω, per-fragment texel sums blended over the triangle; a CPU
+//!   reference and a wgpu renderer behind the default feature `gpu`) — §5.5.
 //!
 //! γ is computed apart from the texel sum so that environment illumination (γ*, §5.5.2) can
 //! accumulate many light directions into it ([`BtfPca::accumulate_gamma`]). Background: the
@@ -65,6 +68,7 @@ pub mod format;
 mod io;
 mod model;
 pub mod reconstruct;
+pub mod render;
 pub mod sampling;
 pub mod stats;
 

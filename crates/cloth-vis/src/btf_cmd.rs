@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use btf::{BtfDir, BtfPca, BtfPcaParams, ErrorStats, Sampling};
+use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Error;
@@ -94,7 +95,10 @@ impl CompressSummary {
     /// One line for the terminal.
     pub fn line(&self) -> String {
         let clamp = if self.kept.0 < self.requested {
-            format!(" (c_j {}..={} kept: clamped to each slot's rank)", self.kept.0, self.kept.1)
+            format!(
+                " (c_j {}..={} kept: clamped to each slot's rank)",
+                self.kept.0, self.kept.1
+            )
         } else {
             String::new()
         };
@@ -240,19 +244,14 @@ pub fn run_synth(request_: &SynthRequest) -> Result<SynthSummary, Error> {
     })
 }
 
-fn write_views(
-    woven: &synth::WovenBtf,
-    request_: &SynthRequest,
-    dir: &Path,
-) -> Result<(), Error> {
+fn write_views(woven: &synth::WovenBtf, request_: &SynthRequest, dir: &Path) -> Result<(), Error> {
     let s = request_.sampling;
     let progress = bar(request_.progress, btf::DIRECTIONS as u64, "view slots");
     for view in 0..btf::DIRECTIONS {
         let hits = woven.view(s.vector(view))?;
         btf::write_btf_view(dir, s, woven.res(), view, |light| {
             hits.shade(s.vector(light))
-        })
-?;
+        })?;
         progress.inc(1);
     }
     progress.finish_and_clear();
@@ -292,11 +291,9 @@ pub fn run_compress(request_: &CompressRequest) -> Result<CompressSummary, Error
         &request_.params,
         |j| dir.load_view(j),
         Some(&tick),
-    )
-    ?;
+    )?;
     progress.finish_and_clear();
-    pca.write(&request_.out)
-        ?;
+    pca.write(&request_.out)?;
     let file_bytes = std::fs::metadata(&request_.out)
         .map(|m| m.len())
         .unwrap_or(0);
@@ -349,5 +346,197 @@ pub fn run_stats(dir: &Path, file: &Path, progress: bool) -> Result<StatsSummary
         raw_bytes: raw_bytes(pca.width(), pca.height()),
         file_bytes: std::fs::metadata(file).map(|m| m.len()).unwrap_or(0),
         error,
+    })
+}
+
+/// The light of `btf render`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RenderLight {
+    /// A directional light: world-space direction towards the light.
+    Direction(Vec3),
+    /// A point light at this world-space position (no distance falloff, eq. 5.4).
+    Position(Vec3),
+}
+
+/// What `cloth-vis btf render` was asked to do.
+#[derive(Clone, Debug)]
+pub struct RenderRequest {
+    /// A mesh file with per-vertex UVs (.obj, .ply, .gltf, .glb) or `synth:cloth` (the last
+    /// frame of the synthetic drape).
+    pub mesh: PathBuf,
+    /// The `.btfpca` material.
+    pub btf: PathBuf,
+    /// The light.
+    pub light: RenderLight,
+    /// Linear RGB radiance g of the light.
+    pub radiance: Vec3,
+    /// Direction from the mesh towards the camera (the camera frames the mesh).
+    pub camera_direction: Vec3,
+    /// Image size in pixels.
+    pub size: [u32; 2],
+    /// Texture repeats across the mesh's UV range.
+    pub uv_scale: f32,
+    /// Draw plain texture mapping of the same material beside it (the thesis's Fig. 5.16).
+    pub beside_plain: bool,
+    /// Use the CPU reference renderer instead of the GPU.
+    pub cpu: bool,
+    /// The PNG to write.
+    pub out: PathBuf,
+}
+
+/// What `render` did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSummary {
+    /// Vertices and triangles drawn.
+    pub mesh: (usize, usize),
+    /// Image size written.
+    pub size: [u32; 2],
+    /// `gpu` or `cpu`.
+    pub backend: &'static str,
+    /// Wall-clock seconds of rendering (not loading).
+    pub seconds: f64,
+}
+
+impl RenderSummary {
+    /// One line for the terminal.
+    pub fn line(&self) -> String {
+        format!(
+            "btf render: {} vertices, {} triangles -> {}x{} ({}) in {:.2} s",
+            self.mesh.0, self.mesh.1, self.size[0], self.size[1], self.backend, self.seconds
+        )
+    }
+}
+
+/// The mesh of `btf render` as a world object with UVs.
+fn render_mesh(path: &Path) -> Result<crate::run::WorldObject, Error> {
+    let (positions, triangles, uvs) = if path == Path::new("synth:cloth") {
+        let anim = synth::simulate_cloth(&synth::ClothParams::default())?;
+        let last = anim.frames.len() - 1;
+        (anim.frames[last].clone(), anim.triangles, Some(anim.uvs))
+    } else {
+        let (mesh, _) = meshio::load_mesh(path, &meshio::LoadOptions::default())?;
+        (mesh.positions, mesh.triangles, mesh.uvs)
+    };
+    if uvs.is_none() {
+        return Err(request(
+            path,
+            "has no per-vertex texture coordinates, and a BTF is looked up by them".to_owned(),
+        ));
+    }
+    let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
+    Ok(crate::run::WorldObject {
+        name: path.display().to_string(),
+        positions,
+        normals,
+        triangles,
+        uvs,
+        albedo: Vec3::ONE,
+        two_sided: true,
+        front: None,
+        back: None,
+    })
+}
+
+/// Runs `btf render`: the mesh textured by the compressed BTF under one light (thesis §5.5),
+/// on the GPU (`gpu`) or the CPU reference (`request.cpu`).
+///
+/// # Errors
+/// An output that is not `.png` or a size of 0 (refused before loading); a mesh without UVs;
+/// a missing GPU without `--cpu`; file, tangent and rendering errors. Nothing is written on
+/// error.
+pub fn run_render(
+    request_: &RenderRequest,
+    gpu: Option<&gpu_context::GpuContext>,
+) -> Result<RenderSummary, Error> {
+    let png = request_
+        .out
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !png {
+        return Err(request(
+            &request_.out,
+            "the image is written as .png".to_owned(),
+        ));
+    }
+    let [w, h] = request_.size;
+    if !(1..=crate::scene::MAX_IMAGE_SIDE).contains(&w)
+        || !(1..=crate::scene::MAX_IMAGE_SIDE).contains(&h)
+    {
+        return Err(request(
+            &request_.out,
+            format!(
+                "--size {w}x{h}: each side must be 1..={}",
+                crate::scene::MAX_IMAGE_SIDE
+            ),
+        ));
+    }
+    if !(request_.uv_scale.is_finite() && request_.uv_scale > 0.0) {
+        return Err(request(
+            &request_.out,
+            format!("--uv-scale {}: must be finite and > 0", request_.uv_scale),
+        ));
+    }
+    let gpu = match (request_.cpu, gpu) {
+        (true, _) => None,
+        (false, Some(g)) => Some(g),
+        (false, None) => {
+            return Err(request(
+                &request_.out,
+                "no GPU adapter was found (install Mesa's lavapipe: apt-get install \
+                 mesa-vulkan-drivers), or pass --cpu for the CPU reference renderer"
+                    .to_owned(),
+            ));
+        }
+    };
+    let pca = BtfPca::read(&request_.btf)?;
+    let object = render_mesh(&request_.mesh)?;
+    let (centre, radius) =
+        crate::camera::bounding_sphere(object.positions.iter()).unwrap_or((Vec3::ZERO, 1.0));
+    let desc = crate::scene::CameraDesc {
+        width: w,
+        height: h,
+        direction: request_.camera_direction.to_array(),
+        ..crate::scene::CameraDesc::default()
+    };
+    let framed = crate::camera::Camera::frame(&desc, centre, radius);
+    let camera = btf::render::Camera::look_at(
+        framed.eye,
+        framed.target,
+        Vec3::from(desc.up),
+        desc.fov_deg,
+        w,
+        h,
+    );
+    let light = match request_.light {
+        RenderLight::Direction(d) => btf::render::Light::Directional {
+            dir_to_light_world: d,
+            radiance: request_.radiance,
+        },
+        RenderLight::Position(p) => btf::render::Light::Point {
+            position_world: p,
+            radiance: request_.radiance,
+        },
+    };
+    let mut params = btf::render::RenderParams::default();
+    params.uv_scale = glam::Vec2::splat(request_.uv_scale);
+    let start = Instant::now();
+    let objects = [&object];
+    let image = crate::btf_stage::render_objects(gpu, &pca, &objects, &light, &camera, &params)?;
+    let picture = if request_.beside_plain {
+        let plain = crate::btf_stage::plain_material(&pca)?;
+        let flat =
+            crate::btf_stage::render_objects(gpu, &plain, &objects, &light, &camera, &params)?;
+        crate::btf_stage::side_by_side(&image, &flat)
+    } else {
+        crate::btf_stage::single(&image)
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    crate::strip::write_png(&request_.out, &picture)?;
+    Ok(RenderSummary {
+        mesh: (object.positions.len(), object.triangles.len()),
+        size: [picture.width(), picture.height()],
+        backend: if gpu.is_some() { "gpu" } else { "cpu" },
+        seconds,
     })
 }

@@ -15,7 +15,8 @@ pub fn demo_scene() -> Result<Scene, Error> {
     Scene::from_toml(DEMO_SCENE, Path::new("."), "embedded demo scene")
 }
 
-/// Run the demo, writing `demo.png`, `demo.exr` and the run report into `out_dir`.
+/// Run the demo, writing `demo.png`, `demo.exr`, `btf.png` (the cloth with the synthetic BTF
+/// beside plain texturing) and the run report into `out_dir`.
 ///
 /// # Errors
 /// As [`run_scene`]; without a GPU adapter the error says what to install.

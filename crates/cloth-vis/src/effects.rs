@@ -47,7 +47,7 @@ impl Effect {
     /// Whether this build contains the effect's stage. Effects that are not built yet are
     /// rejected when a scene is validated, before any work starts.
     pub fn is_built(self) -> bool {
-        matches!(self, Effect::Lighting | Effect::SelfShadowing)
+        matches!(self, Effect::Lighting | Effect::SelfShadowing | Effect::Btf)
     }
 
     /// The crate that will provide an effect that is not built yet.

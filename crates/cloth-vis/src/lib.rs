@@ -36,6 +36,7 @@
 pub mod anim_cmd;
 pub mod anim_compress_cmd;
 pub mod btf_cmd;
+pub mod btf_stage;
 pub mod camera;
 pub mod demo;
 pub mod effects;

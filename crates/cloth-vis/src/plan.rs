@@ -8,6 +8,7 @@
 //! | `visibility` | `self-shadowing` (the visibility matrix M, occlusion-gpu) |
 //! | `lighting` | `lighting` or `self-shadowing` (per-vertex radiance, with M when computed) |
 //! | `render` | always (PNG/EXR) |
+//! | `btf` | `btf` (a compressed BTF on the objects with UVs, beside plain texturing; its own PNG) |
 //!
 //! Later effects (self-shadowing, BTF, shadow volumes, translucency) add their own stages here
 //! without touching the others.
@@ -33,6 +34,8 @@ pub enum Stage {
     Lighting,
     /// Rasterise and write images.
     Render,
+    /// The BTF material on the chosen objects, beside plain texture mapping (own image).
+    Btf,
 }
 
 impl Stage {
@@ -45,6 +48,7 @@ impl Stage {
             Stage::Visibility => "visibility",
             Stage::Lighting => "lighting",
             Stage::Render => "render",
+            Stage::Btf => "btf",
         }
     }
 
@@ -58,8 +62,9 @@ impl Stage {
                 Stage::Visibility,
                 Stage::Lighting,
             ],
+            Effect::Btf => &[Stage::Btf],
             // Not built yet: validation rejects them before planning.
-            Effect::Btf | Effect::ShadowVolumes | Effect::Translucency => &[],
+            Effect::ShadowVolumes | Effect::Translucency => &[],
         }
     }
 }

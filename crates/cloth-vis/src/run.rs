@@ -51,6 +51,9 @@ pub struct WorldObject {
     pub normals: Vec<Vec3>,
     /// Triangles.
     pub triangles: Vec<[u32; 3]>,
+    /// Texture coordinates, one per position, when the source has them (the synthetic cloth
+    /// and meshes with per-vertex UVs); the `btf` effect needs them.
+    pub uvs: Option<Vec<glam::Vec2>>,
     /// Albedo ρ.
     pub albedo: Vec3,
     /// Lit on both sides.
@@ -146,6 +149,13 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         Ok((image, params))
     })?;
 
+    if plan.contains(Stage::Btf) {
+        let written = timer.run(Stage::Btf, || {
+            crate::btf_stage::run(scene, out_dir, &gpu, &objects)
+        })?;
+        outputs.extend(written);
+    }
+
     let mut report = RunReport {
         scene: scene.name.clone(),
         origin: scene.origin.clone(),
@@ -208,11 +218,16 @@ fn load_geometry(
     let mut objects = Vec::with_capacity(scene.objects.len());
     let mut params = serde_json::Map::new();
     for (index, desc) in scene.objects.iter().enumerate() {
-        let (positions, triangles, detail) = match (scene.geometry_source(index)?, &cloth) {
+        let (positions, triangles, uvs, detail) = match (scene.geometry_source(index)?, &cloth) {
             (GeometrySource::SynthCloth, Some(anim)) => {
                 let frame = frame_index(&desc.name, desc.frame, anim.frames.len())?;
                 let detail = json!({ "source": "synth:cloth", "frame": frame, "frames": anim.frames.len(), "grid": anim.grid });
-                (anim.frames[frame].clone(), anim.triangles.clone(), detail)
+                (
+                    anim.frames[frame].clone(),
+                    anim.triangles.clone(),
+                    Some(anim.uvs.clone()),
+                    detail,
+                )
             }
             (GeometrySource::SynthCloth, None) => unreachable!("uses_cloth is true for this scene"),
             (GeometrySource::SynthClothObstacle, _) => {
@@ -223,6 +238,7 @@ fn load_geometry(
                 (
                     positions,
                     triangles,
+                    None,
                     json!({ "source": "synth:cloth-obstacle" }),
                 )
             }
@@ -246,6 +262,7 @@ fn load_geometry(
             positions,
             normals,
             triangles,
+            uvs,
             albedo: Vec3::from(desc.albedo),
             two_sided: desc.two_sided,
             front: None,
@@ -274,7 +291,13 @@ fn frame_index(object: &str, frame: i64, count: usize) -> Result<usize, Error> {
     Ok(resolved as usize)
 }
 
-type Geometry = (Vec<Vec3>, Vec<[u32; 3]>, serde_json::Value);
+/// Positions, triangles, UVs (when the file has them) and what the report says of the input.
+type Geometry = (
+    Vec<Vec3>,
+    Vec<[u32; 3]>,
+    Option<Vec<glam::Vec2>>,
+    serde_json::Value,
+);
 
 fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, Error> {
     let has_ext = |ext: &str| {
@@ -302,7 +325,7 @@ fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, E
             "degenerate_triangles": report.degenerate_triangles.len(),
         });
         let positions = anim.frames[frame].clone();
-        return Ok((positions, anim.triangles, detail));
+        return Ok((positions, anim.triangles, anim.uvs, detail));
     }
     let (mesh, report) = meshio::load_mesh(path, &meshio::LoadOptions::default())?;
     let detail = json!({
@@ -311,7 +334,7 @@ fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, E
         "degenerate_triangles": report.degenerate_triangles.len(),
         "duplicate_positions": report.duplicate_positions,
     });
-    Ok((mesh.positions, mesh.triangles, detail))
+    Ok((mesh.positions, mesh.triangles, mesh.uvs, detail))
 }
 
 fn load_environment(scene: &Scene) -> Result<(lightsphere::Environment, serde_json::Value), Error> {

@@ -71,6 +71,9 @@ pub struct Scene {
     /// Image outputs.
     #[serde(default)]
     pub output: OutputDesc,
+    /// The BTF material (the `btf` effect).
+    #[serde(default)]
+    pub btf: BtfDesc,
     /// Folder that relative paths are resolved against (the scene file's folder).
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -378,6 +381,82 @@ pub enum GeometrySource {
     File(PathBuf),
 }
 
+/// The BTF material of the `btf` effect (thesis §5.3–5.5).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BtfDesc {
+    /// `synth:woven` (the woven-cloth BTF, compressed in memory) or a `.btfpca` file.
+    #[serde(default = "default_btf_source")]
+    pub source: String,
+    /// Objects that wear it, by name (default: every object with texture coordinates).
+    #[serde(default)]
+    pub objects: Vec<String>,
+    /// Texels per side of `synth:woven`.
+    #[serde(default = "default_btf_res")]
+    pub res: usize,
+    /// Eigen-normtextures per view slot for `synth:woven`.
+    #[serde(default = "default_btf_components")]
+    pub components: usize,
+    /// World-space direction towards the (directional) light.
+    #[serde(default = "default_btf_light_dir")]
+    pub light_dir: [f32; 3],
+    /// Linear RGB radiance g of the light (eq. 5.4).
+    #[serde(default = "default_btf_radiance")]
+    pub radiance: [f32; 3],
+    /// Texture repeats across the object's UV range.
+    #[serde(default = "default_btf_uv_scale")]
+    pub uv_scale: f32,
+    /// The picture: the BTF on the left, plain texture mapping on the right.
+    #[serde(default = "default_btf_png")]
+    pub png: String,
+}
+
+fn default_btf_source() -> String {
+    "synth:woven".to_owned()
+}
+fn default_btf_res() -> usize {
+    32
+}
+fn default_btf_components() -> usize {
+    btf::DEFAULT_COMPONENTS
+}
+fn default_btf_light_dir() -> [f32; 3] {
+    [0.4, 0.8, 0.45]
+}
+fn default_btf_radiance() -> [f32; 3] {
+    [1.0, 1.0, 1.0]
+}
+fn default_btf_uv_scale() -> f32 {
+    6.0
+}
+fn default_btf_png() -> String {
+    "btf.png".to_owned()
+}
+
+impl Default for BtfDesc {
+    fn default() -> Self {
+        Self {
+            source: default_btf_source(),
+            objects: Vec::new(),
+            res: default_btf_res(),
+            components: default_btf_components(),
+            light_dir: default_btf_light_dir(),
+            radiance: default_btf_radiance(),
+            uv_scale: default_btf_uv_scale(),
+            png: default_btf_png(),
+        }
+    }
+}
+
+/// Where the BTF material comes from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BtfSource {
+    /// The woven-cloth BTF of `synth`, generated and compressed in memory.
+    SynthWoven,
+    /// A `.btfpca` file.
+    File(PathBuf),
+}
+
 /// Where the environment comes from.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum EnvironmentSource {
@@ -464,6 +543,81 @@ impl Scene {
         }
     }
 
+    /// Resolve the BTF material's source.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for an unknown `synth:` name.
+    pub fn btf_source(&self) -> Result<BtfSource, Error> {
+        match self.btf.source.strip_prefix(SYNTH_PREFIX) {
+            Some("woven") => Ok(BtfSource::SynthWoven),
+            Some(other) => Err(self.invalid(
+                "btf.source",
+                format!("unknown procedural source \"synth:{other}\"; known: synth:woven"),
+            )),
+            None => Ok(BtfSource::File(self.base_dir.join(&self.btf.source))),
+        }
+    }
+
+    /// Checks the `[btf]` table (only when the `btf` effect is requested).
+    fn validate_btf(&self) -> Result<(), Error> {
+        let b = &self.btf;
+        if let BtfSource::File(path) = self.btf_source()? {
+            if !path.exists() {
+                return Err(
+                    self.invalid("btf.source", format!("{} does not exist", path.display()))
+                );
+            }
+        }
+        if let Some(name) = b
+            .objects
+            .iter()
+            .find(|n| !self.objects.iter().any(|o| &o.name == *n))
+        {
+            return Err(self.invalid("btf.objects", format!("no object is named {name:?}")));
+        }
+        if !(1..=512).contains(&b.res) {
+            return Err(self.invalid("btf.res", format!("{} is outside 1..=512", b.res)));
+        }
+        if !(1..=btf::MAX_COMPONENTS).contains(&b.components) {
+            return Err(self.invalid(
+                "btf.components",
+                format!("{} is outside 1..={}", b.components, btf::MAX_COMPONENTS),
+            ));
+        }
+        let dir = Vec3::from(b.light_dir);
+        if !dir.is_finite() || dir.length_squared() == 0.0 {
+            return Err(self.invalid(
+                "btf.light_dir",
+                format!("{:?} must be a finite non-zero direction", b.light_dir),
+            ));
+        }
+        if b.radiance.iter().any(|c| !(c.is_finite() && *c >= 0.0)) {
+            return Err(self.invalid(
+                "btf.radiance",
+                format!("{:?} must be finite and ≥ 0", b.radiance),
+            ));
+        }
+        if !(b.uv_scale.is_finite() && b.uv_scale > 0.0) {
+            return Err(self.invalid(
+                "btf.uv_scale",
+                format!("{} must be finite and > 0", b.uv_scale),
+            ));
+        }
+        if Path::new(&b.png)
+            .file_name()
+            .is_none_or(|f| f != b.png.as_str())
+        {
+            return Err(self.invalid(
+                "btf.png",
+                format!(
+                    "{:?} must be a plain file name inside the output folder",
+                    b.png
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Resolve the environment's source, if there is an environment.
     ///
     /// # Errors
@@ -539,6 +693,9 @@ impl Scene {
                     );
                 }
             }
+        }
+        if effects.contains(&Effect::Btf) {
+            self.validate_btf()?;
         }
         let lit = effects
             .iter()

@@ -7,6 +7,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use btf::{BtfDir, BtfPca, Sampling};
+use image::GenericImageView as _;
 
 fn cli(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_cloth-vis"))
@@ -31,9 +32,21 @@ fn stderr(out: &Output) -> String {
 fn synth_compress_stats_round_trip_at_64() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("woven");
-    let out = cli(&["btf", "synth", "--res", "64", "--out", text(&dir), "--quiet"]);
+    let out = cli(&[
+        "btf",
+        "synth",
+        "--res",
+        "64",
+        "--out",
+        text(&dir),
+        "--quiet",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    assert!(stdout(&out).contains("6561 images of 64x64 (H1)"), "{}", stdout(&out));
+    assert!(
+        stdout(&out).contains("6561 images of 64x64 (H1)"),
+        "{}",
+        stdout(&out)
+    );
     // The folder is a real UBO2003 folder: the loader finds every pair at 64².
     let folder = BtfDir::open(&dir).unwrap();
     assert_eq!(
@@ -62,11 +75,17 @@ fn synth_compress_stats_round_trip_at_64() {
     assert!(out.status.success(), "{}", stderr(&out));
     let line = stdout(&out);
     let raw = 81 * 81 * 3 * 64 * 64;
-    assert!(line.contains(&format!("{:.1} MB of 8-bit images", raw as f64 / 1e6)), "{line}");
+    assert!(
+        line.contains(&format!("{:.1} MB of 8-bit images", raw as f64 / 1e6)),
+        "{line}"
+    );
     let pca = BtfPca::read(&file).unwrap();
     assert!(pca.slots().iter().all(|s| s.components() == 16));
     let size = std::fs::metadata(&file).unwrap().len();
-    assert!(line.contains(&format!("{:.1} MB (", size as f64 / 1e6)), "{line}");
+    assert!(
+        line.contains(&format!("{:.1} MB (", size as f64 / 1e6)),
+        "{line}"
+    );
     // c = 16 of ≤ 80 components per slot, 8-bit bases: at least 4:1 over the 8-bit images.
     assert!((raw as f64) / (size as f64) > 4.0, "{raw} / {size}");
 
@@ -77,7 +96,10 @@ fn synth_compress_stats_round_trip_at_64() {
     let error = pca.stats(&folder, None).unwrap();
     assert_eq!(error.images, 6561);
     assert!(
-        line.contains(&format!("RMS {:.3} (8-bit sRGB), PSNR {:.2} dB", error.rms_srgb8, error.psnr_db)),
+        line.contains(&format!(
+            "RMS {:.3} (8-bit sRGB), PSNR {:.2} dB",
+            error.rms_srgb8, error.psnr_db
+        )),
         "{line}"
     );
     // More components, less error (the per-view PCA is a truncation, eq. 5.1).
@@ -124,7 +146,14 @@ fn bad_input_is_refused_naming_the_file_and_nothing_is_written() {
 
     // A wrong output name is refused before any work.
     let bad = tmp.path().join("w.bin");
-    let out = cli(&["btf", "compress", text(&dir), "--out", text(&bad), "--quiet"]);
+    let out = cli(&[
+        "btf",
+        "compress",
+        text(&dir),
+        "--out",
+        text(&bad),
+        "--quiet",
+    ]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("w.bin"));
     assert!(!bad.exists());
@@ -138,7 +167,14 @@ fn bad_input_is_refused_naming_the_file_and_nothing_is_written() {
         dir.join("tl017 pl060 tv034 pv090.png")
     };
     std::fs::remove_file(&missing).unwrap();
-    let out = cli(&["btf", "compress", text(&dir), "--out", text(&file), "--quiet"]);
+    let out = cli(&[
+        "btf",
+        "compress",
+        text(&dir),
+        "--out",
+        text(&file),
+        "--quiet",
+    ]);
     assert!(!out.status.success());
     let name = missing.file_name().unwrap().to_str().unwrap();
     assert!(stderr(&out).contains(name), "{}", stderr(&out));
@@ -167,4 +203,132 @@ fn bad_input_is_refused_naming_the_file_and_nothing_is_written() {
     let out = cli(&["btf", "stats", text(&a), text(&corrupt)]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("c.btfpca"), "{}", stderr(&out));
+}
+
+#[test]
+fn render_on_the_gpu_matches_the_cpu_reference_and_bad_requests_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("w");
+    let file = tmp.path().join("w.btfpca");
+    assert!(
+        cli(&[
+            "btf",
+            "synth",
+            "--res",
+            "16",
+            "--out",
+            text(&dir),
+            "--quiet"
+        ])
+        .status
+        .success()
+    );
+    assert!(
+        cli(&[
+            "btf",
+            "compress",
+            text(&dir),
+            "--out",
+            text(&file),
+            "--quiet"
+        ])
+        .status
+        .success()
+    );
+    let render = |extra: &[&str], out: &Path| {
+        let mut args = vec![
+            "btf",
+            "render",
+            "synth:cloth",
+            "--btf",
+            text(&file),
+            "--light-dir",
+            "0.2,0.9,0.6",
+            "--size",
+            "96x96",
+            "--out",
+            text(out),
+        ];
+        args.extend_from_slice(extra);
+        cli(&args)
+    };
+    let cpu = tmp.path().join("cpu.png");
+    let out = render(&["--cpu"], &cpu);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("(cpu)"));
+    let cpu_image = image::open(&cpu).unwrap().to_rgb8();
+    assert_eq!(cpu_image.dimensions(), (96, 96));
+    let lit = cpu_image.pixels().filter(|p| p.0 != [0, 0, 0]).count();
+    assert!(lit > 1000, "the cloth covers only {lit} pixels");
+
+    if gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()).is_err() {
+        test_data::skip::<()>("no GPU adapter for the GPU half of the render test");
+    } else {
+        let gpu = tmp.path().join("gpu.png");
+        let out = render(&[], &gpu);
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(stdout(&out).contains("(gpu)"));
+        let gpu_image = image::open(&gpu).unwrap().to_rgb8();
+        let diff: u64 = gpu_image
+            .as_raw()
+            .iter()
+            .zip(cpu_image.as_raw())
+            .map(|(a, b)| u64::from(a.abs_diff(*b)))
+            .sum();
+        let mean = diff as f64 / gpu_image.as_raw().len() as f64;
+        assert!(mean <= 1.0, "GPU and CPU differ by {mean} codes on average");
+        // Beside plain texturing: twice as wide, and the halves differ.
+        let both = tmp.path().join("both.png");
+        let out = render(&["--beside-plain"], &both);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let both = image::open(&both).unwrap().to_rgb8();
+        assert_eq!(both.dimensions(), (192, 96));
+        assert_eq!(
+            both.view(0, 0, 96, 96).to_image().as_raw(),
+            gpu_image.as_raw()
+        );
+        assert_ne!(
+            both.view(96, 0, 96, 96).to_image().as_raw(),
+            gpu_image.as_raw()
+        );
+    }
+
+    // No light, a wrong extension, a mesh without UVs: refused, nothing written.
+    let bad = tmp.path().join("bad.png");
+    let out = cli(&[
+        "btf",
+        "render",
+        "synth:cloth",
+        "--btf",
+        text(&file),
+        "--out",
+        text(&bad),
+    ]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("--light-dir"), "{}", stderr(&out));
+    let jpg = tmp.path().join("x.jpg");
+    let out = render(&["--cpu"], &jpg);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("x.jpg"));
+    let obj = tmp.path().join("plain.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let out = cli(&[
+        "btf",
+        "render",
+        text(&obj),
+        "--btf",
+        text(&file),
+        "--light-dir",
+        "0,0,1",
+        "--cpu",
+        "--out",
+        text(&bad),
+    ]);
+    assert!(!out.status.success());
+    let e = stderr(&out);
+    assert!(
+        e.contains("plain.obj") && e.contains("texture coordinates"),
+        "{e}"
+    );
+    assert!(!bad.exists() && !jpg.exists());
 }

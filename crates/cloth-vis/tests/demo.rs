@@ -55,12 +55,42 @@ fn demo_writes_non_constant_png_exr_and_a_report_of_the_planned_stages() {
     assert!(exr.iter().any(|p| p != &exr[0]));
     assert!(dir.path().join("demo.exr").metadata().unwrap().len() > 1000);
 
+    // btf.png: the cloth with the woven BTF (left) beside plain texturing (right), same
+    // camera, same coverage, different appearance (view-dependent, shadowed mesostructure).
+    let btf = image::open(dir.path().join("btf.png")).unwrap().to_rgb8();
+    assert_eq!(btf.dimensions(), (2 * 160, 128));
+    let (mut covered, mut differ, mut coverage_mismatch) = (0usize, 0usize, 0usize);
+    for y in 0..128 {
+        for x in 0..160 {
+            let (l, r) = (btf.get_pixel(x, y).0, btf.get_pixel(x + 160, y).0);
+            let (lb, rb) = (l != [0, 0, 0], r != [0, 0, 0]);
+            if lb != rb {
+                coverage_mismatch += 1;
+            }
+            if lb && rb {
+                covered += 1;
+                if l.iter().zip(&r).any(|(a, b)| a.abs_diff(*b) > 8) {
+                    differ += 1;
+                }
+            }
+        }
+    }
+    assert!(covered > 1000, "the cloth covers only {covered} pixels");
+    assert!(
+        differ * 4 > covered,
+        "BTF and plain texture differ on only {differ} of {covered}"
+    );
+    assert!(
+        coverage_mismatch * 20 < covered,
+        "{coverage_mismatch} pixels lit on one side only"
+    );
+
     let json: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("run-report.json")).unwrap())
             .unwrap();
     assert_eq!(
         json["effects"],
-        serde_json::json!(["lighting", "self-shadowing"])
+        serde_json::json!(["lighting", "self-shadowing", "btf"])
     );
     let vis = json["stages"]
         .as_array()

@@ -41,9 +41,44 @@ fn the_demo_scene_plans_lighting() {
             Stage::LightDirections,
             Stage::Visibility,
             Stage::Lighting,
-            Stage::Render
+            Stage::Render,
+            Stage::Btf
         ]
     );
+}
+
+#[test]
+fn btf_alone_plans_its_stage_and_no_lighting() {
+    let plan = Plan::for_scene(&scene(
+        &format!("effects = [\"btf\"]\n{CLOTH}"),
+        ".".as_ref(),
+    ))
+    .unwrap();
+    assert_eq!(plan.stages(), &[Stage::Geometry, Stage::Render, Stage::Btf]);
+}
+
+#[test]
+fn bad_btf_tables_are_named_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    for (table, key) in [
+        ("source = \"missing.btfpca\"", "btf.source"),
+        ("source = \"synth:silk\"", "btf.source"),
+        ("objects = [\"shirt\"]", "btf.objects"),
+        ("res = 0", "btf.res"),
+        ("components = 0", "btf.components"),
+        ("light_dir = [0.0, 0.0, 0.0]", "btf.light_dir"),
+        ("uv_scale = -1.0", "btf.uv_scale"),
+        ("png = \"../escape.png\"", "btf.png"),
+    ] {
+        let text = format!("effects = [\"btf\"]\n{CLOTH}\n[btf]\n{table}\n");
+        let err = Plan::for_scene(&scene(&text, dir.path()))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(key), "{table}: {err}");
+    }
+    // Without the effect, the table is not checked (nothing of it runs).
+    let text = format!("{CLOTH}\n[btf]\nres = 0\n");
+    assert!(Plan::for_scene(&scene(&text, dir.path())).is_ok());
 }
 
 #[test]
@@ -51,21 +86,21 @@ fn an_effect_not_built_yet_is_refused_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let text = format!(
-        "effects = [\"lighting\", \"btf\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
+        "effects = [\"lighting\", \"shadow-volumes\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
     );
     let err = run_scene(&scene(&text, dir.path()), &out, &RunOptions::default()).unwrap_err();
     assert!(
         matches!(
             err,
             Error::EffectNotBuilt {
-                effect: "btf",
-                provider: "btf",
+                effect: "shadow-volumes",
+                provider: "shadows",
                 ..
             }
         ),
         "{err}"
     );
-    assert!(err.to_string().contains("\"btf\""), "{err}");
+    assert!(err.to_string().contains("\"shadow-volumes\""), "{err}");
     assert!(
         !out.exists(),
         "no output folder may be created before validation passes"

@@ -47,6 +47,7 @@ fn object(
         positions,
         normals,
         triangles,
+        uvs: None,
         albedo: Vec3::new(0.5, 0.25, 1.0),
         two_sided,
         front: None,
