@@ -38,7 +38,7 @@ const MAX_CLIP_FRAMES: usize = 400;
 /// Clusters k of the CPCA sweep.
 const SWEEP_K: [usize; 4] = [2, 5, 10, 20];
 /// Components c of the CPCA sweep.
-const SWEEP_C: [usize; 4] = [4, 8, 16, 32];
+const SWEEP_C: [usize; 5] = [4, 8, 16, 32, 64];
 /// Components c of the plain-PCA (k = 1) sweep.
 const PCA_C: [usize; 7] = [2, 4, 8, 16, 32, 64, 128];
 /// q_c = q_w of the sweeps (the thesis advises ≥ 18; 12 and 14 trade error for rate).
@@ -254,7 +254,8 @@ fn bits_at(points: &[Point], method: Method, da: f64) -> Option<f64> {
         .min_by(f64::total_cmp)
 }
 
-/// Points of `method` not dominated by another (lower or equal bpvf and d_a), by bpvf.
+/// Points of `method` not dominated by another (lower or equal bpvf and d_a), by bpvf; a
+/// point must lower d_a by at least 1% to count as better.
 fn front(points: &[Point], method: Method) -> Vec<Point> {
     let mut mine: Vec<Point> = points
         .iter()
@@ -264,7 +265,7 @@ fn front(points: &[Point], method: Method) -> Vec<Point> {
     mine.sort_by(|a, b| a.bpvf.total_cmp(&b.bpvf).then(a.da.total_cmp(&b.da)));
     let mut out: Vec<Point> = Vec::new();
     for p in mine {
-        if out.last().is_none_or(|l| p.da < l.da) {
+        if out.last().is_none_or(|l| p.da < 0.99 * l.da) {
             out.push(p);
         }
     }
