@@ -16,11 +16,16 @@
 //!   animation and the synthetic cloth — rate–distortion of CPCA against plain PCA and
 //!   per-frame quantization, the Table 3.4 front, Figs. 3.14/3.15/3.17 and Table 3.5 on the
 //!   chicken, cluster pictures (`target/repro/anim-compression.md` and its plots).
+//! - `cargo xtask repro btf [--quick]`: per-view PCA compression of the synthetic woven BTF
+//!   (thesis §5.4) — error, time and `.btfpca` size against c, eigenvalue decay and a Fig. 5.7
+//!   panel; FMF, PCMF and PVMF side by side (Fig. 2.22); compression time and peak memory at
+//!   256² (`target/repro/btf.md`, `btf-error.svg`, `btf-eigenvalues.svg`, `btf-fig5.7.png`).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 
 mod compare_clustering;
 mod repro_anim_compression;
+mod repro_btf;
 mod repro_jumpmap;
 mod repro_lightsphere;
 mod repro_visibility;
@@ -90,6 +95,14 @@ enum Repro {
         #[arg(long)]
         only: Option<String>,
     },
+    /// BTF compression (thesis §5.4, §2.1.12): error, time and size against c (Figs. 5.7/5.8),
+    /// FMF / PCMF / PVMF side by side (Fig. 2.22), and the 256² compression's time and peak
+    /// memory.
+    Btf {
+        /// 32² throughout and no 256² timing.
+        #[arg(long)]
+        quick: bool,
+    },
 }
 
 /// `target/repro` of the workspace.
@@ -113,6 +126,9 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::AnimCompression { only },
         } => repro_anim_compression::run(&repro_dir()?, only.as_deref()),
+        Command::Repro {
+            what: Repro::Btf { quick },
+        } => repro_btf::run(&repro_dir()?, quick),
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {

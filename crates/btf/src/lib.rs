@@ -23,7 +23,9 @@
 //! γ is computed apart from the texel sum so that environment illumination (γ*, §5.5.2) can
 //! accumulate many light directions into it ([`BtfPca::accumulate_gamma`]). Background: the
 //! BTF as a set of textures or of apparent BRDFs and its compression by per-view
-//! factorisation are surveyed in §2.1.10–2.1.12.
+//! factorisation are surveyed in §2.1.10–2.1.12; [`compare`](mod@compare) sets per-view
+//! factorisation beside full-matrix and per-cluster factorisation of the texels' ABRDFs
+//! (Fig. 2.22) on one BTF held as 8-bit codes ([`AbrdfMatrix`]).
 //!
 //! Colour: images are handled as **linear** RGB. 8-bit and 16-bit PNG/JPEG files are decoded
 //! through the sRGB transfer function, EXR is taken as linear, and the writer encodes 8-bit
@@ -61,6 +63,7 @@
 //! assert_eq!(pca.texel(0, &gamma, 0, 0), rgb);
 //! ```
 
+pub mod compare;
 pub mod compress;
 pub mod dataset;
 mod error;
@@ -72,6 +75,7 @@ pub mod render;
 pub mod sampling;
 pub mod stats;
 
+pub use compare::{AbrdfMatrix, TexelModel};
 pub use compress::{BtfPcaParams, CompressReport, DEFAULT_COMPONENTS, MAX_COMPONENTS, SlotReport};
 pub use dataset::{BtfDir, ViewSlot, image_file_name};
 pub use error::{BtfError, CodecError, Result};
