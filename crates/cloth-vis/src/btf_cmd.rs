@@ -15,9 +15,9 @@ use std::time::Instant;
 
 use btf::{BtfDir, BtfPca, BtfPcaParams, ErrorStats, Sampling};
 use glam::Vec3;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::Error;
+use crate::run::progress_bar as bar;
 
 /// What `cloth-vis btf synth` was asked to do.
 #[derive(Clone, Debug)]
@@ -156,18 +156,6 @@ fn request(path: &Path, message: String) -> Error {
         path: path.to_owned(),
         message,
     }
-}
-
-fn bar(show: bool, len: u64, message: &'static str) -> ProgressBar {
-    if !show {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(len);
-    if let Ok(style) = ProgressStyle::with_template("{msg:>14} [{bar:40}] {pos}/{len} ({eta})") {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message(message);
-    bar
 }
 
 /// 8-bit RGB bytes of a full 81 × 81 BTF of w × h texels.

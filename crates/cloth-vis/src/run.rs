@@ -174,7 +174,8 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
     })
 }
 
-fn progress_bar(show: bool, len: u64, message: &'static str) -> ProgressBar {
+/// A progress bar on stderr labelled `message`, hidden when `show` is false.
+pub(crate) fn progress_bar(show: bool, len: u64, message: &'static str) -> ProgressBar {
     if !show {
         return ProgressBar::hidden();
     }
