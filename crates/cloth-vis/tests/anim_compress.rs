@@ -3,14 +3,18 @@
 //! `stats` prints the library's numbers, and bad input (a corrupt file, an unsupported output,
 //! mismatched counts) is refused with the file named and nothing written.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use anim_pca::compress::{Compressed, Decoder, bpvf_from_file};
 use cloth_vis::anim_compress_cmd::{
     CompressRequest, DEFAULT_K_MAX, DecompressRequest, run_compress, run_decompress, run_stats,
 };
 use glam::Vec3;
+
+use common::{cli, text};
 
 const VERTICES: usize = 64;
 const FRAMES: usize = 40;
@@ -46,17 +50,6 @@ fn write_clip(dir: &Path) -> (PathBuf, Vec<Vec<Vec3>>) {
     let path = dir.join("clip.npy");
     meshio::write_npy_f32(&path, &[FRAMES, VERTICES, 3], &flat(&frames)).unwrap();
     (path, frames)
-}
-
-fn cli(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cloth-vis"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn text(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 #[track_caller]

@@ -3,22 +3,15 @@
 //! with its images; and refused input (a missing image, a wrong output name, a folder that is
 //! not empty, a `.btfpca` of another BTF) with the file named and nothing written.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 use btf::{BtfDir, BtfPca, Sampling};
 use image::GenericImageView as _;
 
-fn cli(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cloth-vis"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn text(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use common::{cli, text};
 
 fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()

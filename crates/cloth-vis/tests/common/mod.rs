@@ -31,3 +31,16 @@ cloth_frames = 40
 seed = 3
 sky_width = 256
 "#;
+
+/// Runs the `cloth-vis` binary with `args`.
+pub fn cli(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_cloth-vis"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// A path as a command-line argument.
+pub fn text(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
