@@ -14,14 +14,10 @@ use compress_common as common;
 use anim_pca::AnimPcaError;
 use anim_pca::compress::{Compressed, CpcaParams, Decoder, GpuDecoder};
 use glam::Vec3;
-use gpu_context::{GpuContext, GpuOptions};
+use gpu_context::GpuContext;
 
-fn gpu() -> Option<GpuContext> {
-    match GpuContext::new(&GpuOptions::default()) {
-        Ok(ctx) => Some(ctx),
-        Err(e) => test_data::skip(&format!("no GPU adapter: {e}")),
-    }
-}
+/// The shared GPU-or-skip harness (fails under CI, visible skip otherwise).
+use gpu_context::testing::gpu_or_skip as gpu;
 
 /// Three independently spinning bars (k = 3 clusters), 40 vertices each, 31 frames.
 fn packed(bits: u8, time_components: Option<usize>) -> Compressed {

@@ -260,3 +260,14 @@ impl BtfError {
         }
     }
 }
+
+impl From<::render::CameraError> for BtfError {
+    fn from(e: ::render::CameraError) -> Self {
+        BtfError::InvalidParameter {
+            what: "Camera",
+            name: e.name,
+            value: e.value,
+            reason: e.reason,
+        }
+    }
+}

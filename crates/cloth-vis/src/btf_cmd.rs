@@ -396,7 +396,7 @@ impl RenderSummary {
 }
 
 /// The mesh of `btf render` as a world object with UVs.
-fn render_mesh(path: &Path) -> Result<crate::run::WorldObject, Error> {
+fn render_mesh(path: &Path) -> Result<crate::object::WorldObject, Error> {
     let (positions, triangles, uvs) = if path == Path::new("synth:cloth") {
         let anim = synth::simulate_cloth(&synth::ClothParams::default())?;
         let last = anim.frames.len() - 1;
@@ -412,7 +412,7 @@ fn render_mesh(path: &Path) -> Result<crate::run::WorldObject, Error> {
         ));
     }
     let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
-    Ok(crate::run::WorldObject {
+    Ok(crate::object::WorldObject {
         name: path.display().to_string(),
         positions,
         normals,
@@ -422,6 +422,7 @@ fn render_mesh(path: &Path) -> Result<crate::run::WorldObject, Error> {
         two_sided: true,
         front: None,
         back: None,
+        animation: None,
     })
 }
 
@@ -480,15 +481,15 @@ pub fn run_render(
     let pca = BtfPca::read(&request_.btf)?;
     let object = render_mesh(&request_.mesh)?;
     let (centre, radius) =
-        crate::camera::bounding_sphere(object.positions.iter()).unwrap_or((Vec3::ZERO, 1.0));
+        render::bounding_sphere(object.positions.iter()).unwrap_or((Vec3::ZERO, 1.0));
     let desc = crate::scene::CameraDesc {
         width: w,
         height: h,
         direction: request_.camera_direction.to_array(),
         ..crate::scene::CameraDesc::default()
     };
-    let framed = crate::camera::Camera::frame(&desc, centre, radius);
-    let camera = btf::render::Camera::look_at(
+    let framed = crate::camera::resolve(&desc, centre, radius);
+    let camera = render::Camera::look_at(
         framed.eye,
         framed.target,
         Vec3::from(desc.up),

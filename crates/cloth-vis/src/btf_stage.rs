@@ -6,21 +6,26 @@
 //! compressed in memory slot by slot (no image files). "Plain texturing" is the BTF's frontal
 //! normtexture (view θ = 0, light θ = 0) used as an ordinary diffuse texture: every view slot
 //! holds it times the light's cosine, so the same renderer draws both halves and only the
-//! material differs. Objects are drawn in scene order, each over the previous where it covers
-//! pixels (no depth test between objects).
+//! material differs.
+//!
+//! In a scene, both halves are full frames of the shared renderer (crate `render`): the BTF
+//! objects are a [`btf::render::BtfDraw`] pass and every other object (the ball, the ground)
+//! is drawn by the Gouraud pass with its lighting, all against one depth buffer, so BTF
+//! objects and plain objects occlude each other.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use btf::render::{BtfMesh, Camera as BtfCamera, Light, RenderParams, RenderedImage};
+use btf::render::{BtfMesh, GpuBtfRenderer, Light, RenderParams, RenderedImage};
 use btf::{BtfPca, BtfPcaParams, Sampling, ViewSlot};
-use glam::{Vec2, Vec3};
-use gpu_context::GpuContext;
+use glam::{Vec2, Vec3, Vec4};
+use gpu_context::{GpuContext, HdrImage};
+use render::{Background, Camera, FrameFormat, FramePass, Renderer};
 use serde_json::json;
 
 use crate::Error;
-use crate::camera::{Camera, bounding_sphere};
-use crate::run::WorldObject;
+use crate::object::WorldObject;
+use crate::run::Look;
 use crate::scene::Scene;
 
 /// The woven BTF generated for `synth:woven`, compressed in memory with `components` terms
@@ -98,6 +103,16 @@ pub struct Layer {
 }
 
 impl Layer {
+    /// A read-back frame: covered where alpha > ½.
+    fn from_hdr(image: &HdrImage) -> Self {
+        Self {
+            width: image.width(),
+            height: image.height(),
+            pixels: image.pixels().iter().map(|p| [p[0], p[1], p[2]]).collect(),
+            covered: image.pixels().iter().map(|p| p[3] > 0.5).collect(),
+        }
+    }
+
     fn from_image(image: &RenderedImage) -> Self {
         Self {
             width: image.width(),
@@ -131,8 +146,31 @@ impl Layer {
     }
 }
 
-/// Renders `objects` (each with UVs) with `pca` through `camera` under `light`, on the GPU
-/// when `gpu` is given and on the CPU reference otherwise, compositing them in order.
+/// The tangent frames of `object` (it needs UVs).
+fn tangents_of(object: &WorldObject) -> Result<(Vec<Vec4>, &[Vec2]), Error> {
+    let uvs = object.uvs.as_deref().ok_or_else(|| Error::Request {
+        path: PathBuf::from(&object.name),
+        message: "a BTF needs texture coordinates and this object has none".to_owned(),
+    })?;
+    let tangents =
+        btf::render::tangent_frames(&object.positions, &object.normals, uvs, &object.triangles)?;
+    Ok((tangents, uvs))
+}
+
+fn btf_mesh<'a>(object: &'a WorldObject, tangents: &'a [Vec4], uvs: &'a [Vec2]) -> BtfMesh<'a> {
+    BtfMesh {
+        positions: &object.positions,
+        normals: &object.normals,
+        tangents,
+        uvs,
+        triangles: &object.triangles,
+    }
+}
+
+/// Renders `objects` (each with UVs) with `pca` through `camera` under `light`: on the GPU
+/// when `gpu` is given, all objects in one single-sample frame with one depth buffer (so
+/// they occlude each other; single-sample so the CPU reference compares pixel for pixel), and
+/// on the CPU reference otherwise, each object over the previous where it covers pixels.
 ///
 /// # Errors
 /// An object without UVs ([`Error::Request`] naming it); renderer errors.
@@ -141,36 +179,36 @@ pub fn render_objects(
     pca: &BtfPca,
     objects: &[&WorldObject],
     light: &Light,
-    camera: &BtfCamera,
+    camera: &Camera,
     params: &RenderParams,
 ) -> Result<Layer, Error> {
-    let renderer = match gpu {
-        Some(g) => Some(btf::render::GpuBtfRenderer::new(&g.device, &g.queue, pca)?),
-        None => None,
-    };
+    if objects.is_empty() {
+        return Err(Error::Request {
+            path: PathBuf::from("btf.objects"),
+            message: "no object to draw with the BTF".to_owned(),
+        });
+    }
+    let frames = objects
+        .iter()
+        .map(|o| tangents_of(o))
+        .collect::<Result<Vec<_>, _>>()?;
+    if let Some(g) = gpu {
+        let mut renderer = Renderer::new(&g.device, FrameFormat::single_sample(&g.device));
+        let btf = GpuBtfRenderer::for_frame(&g.device, &g.queue, pca, &renderer.pass_context())?;
+        let draws = objects
+            .iter()
+            .zip(&frames)
+            .map(|(o, (t, uv))| btf.prepare(&btf_mesh(o, t, uv), light, camera, params))
+            .collect::<Result<Vec<_>, _>>()?;
+        let passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
+        let background = Background::Color(params.background.to_array());
+        let image = renderer.render(&g.device, &g.queue, camera, background, &passes)?;
+        return Ok(Layer::from_hdr(&image));
+    }
     let mut result: Option<Layer> = None;
-    for object in objects {
-        let uvs = object.uvs.as_deref().ok_or_else(|| Error::Request {
-            path: PathBuf::from(&object.name),
-            message: "a BTF needs texture coordinates and this object has none".to_owned(),
-        })?;
-        let tangents = btf::render::tangent_frames(
-            &object.positions,
-            &object.normals,
-            uvs,
-            &object.triangles,
-        )?;
-        let mesh = BtfMesh {
-            positions: &object.positions,
-            normals: &object.normals,
-            tangents: &tangents,
-            uvs,
-            triangles: &object.triangles,
-        };
-        let image = match &renderer {
-            Some(r) => r.render(&mesh, light, camera, params)?,
-            None => btf::render::render_cpu(pca, &mesh, light, camera, params)?,
-        };
+    for (object, (tangents, uvs)) in objects.iter().zip(&frames) {
+        let mesh = btf_mesh(object, tangents, uvs);
+        let image = btf::render::render_cpu(pca, &mesh, light, camera, params)?;
         match &mut result {
             None => result = Some(Layer::from_image(&image)),
             Some(below) => below.over(&image),
@@ -205,7 +243,37 @@ pub fn side_by_side(left: &Layer, right: &Layer) -> image::RgbaImage {
     out
 }
 
-/// Runs the `btf` stage of a scene: material, plain companion, both renderings, the PNG.
+/// One frame of the scene with `pca` on the BTF objects (a [`btf::render::BtfDraw`] each)
+/// and the Gouraud pass drawing the rest.
+#[allow(clippy::too_many_arguments)] // one frame's inputs; a struct would only rename them
+fn scene_frame(
+    gpu: &GpuContext,
+    renderer: &mut Renderer,
+    pca: &BtfPca,
+    chosen: &[&WorldObject],
+    frames: &[(Vec<Vec4>, &[Vec2])],
+    light: &Light,
+    look: &Look,
+    params: &RenderParams,
+) -> Result<HdrImage, Error> {
+    let btf = GpuBtfRenderer::for_frame(&gpu.device, &gpu.queue, pca, &renderer.pass_context())?;
+    let draws = chosen
+        .iter()
+        .zip(frames)
+        .map(|(o, (t, uv))| btf.prepare(&btf_mesh(o, t, uv), light, &look.camera, params))
+        .collect::<Result<Vec<_>, _>>()?;
+    let passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
+    Ok(renderer.render(
+        &gpu.device,
+        &gpu.queue,
+        &look.camera,
+        look.background,
+        &passes,
+    )?)
+}
+
+/// Runs the `btf` stage of a scene: material, plain companion, both frames, the PNG (left:
+/// BTF, right: plain texture mapping, one exposure for both halves).
 ///
 /// # Errors
 /// Material, object and rendering errors; write errors naming the PNG.
@@ -213,7 +281,9 @@ pub(crate) fn run(
     scene: &Scene,
     out_dir: &Path,
     gpu: &GpuContext,
+    renderer: &mut Renderer,
     objects: &[WorldObject],
+    look: &Look,
 ) -> Result<(Vec<PathBuf>, serde_json::Value), Error> {
     let desc = &scene.btf;
     let start = Instant::now();
@@ -230,23 +300,24 @@ pub(crate) fn run(
         .iter()
         .filter(|o| {
             if desc.objects.is_empty() {
-                o.uvs.is_some()
+                o.uvs.is_some() && o.name != crate::scene::GROUND_NAME
             } else {
                 desc.objects.contains(&o.name)
             }
         })
         .collect();
-    let (centre, radius) = bounding_sphere(objects.iter().flat_map(|o| o.positions.iter()))
-        .unwrap_or((Vec3::ZERO, 1.0));
-    let framed = Camera::frame(&scene.camera, centre, radius);
-    let camera = BtfCamera::look_at(
-        framed.eye,
-        framed.target,
-        Vec3::from(scene.camera.up),
-        scene.camera.fov_deg,
-        scene.camera.width,
-        scene.camera.height,
-    );
+    if chosen.is_empty() {
+        return Err(Error::Request {
+            path: PathBuf::from("btf.objects"),
+            message: "no object to draw with the BTF".to_owned(),
+        });
+    }
+    let frames = chosen
+        .iter()
+        .map(|o| tangents_of(o))
+        .collect::<Result<Vec<_>, _>>()?;
+    let names: Vec<&str> = chosen.iter().map(|o| o.name.as_str()).collect();
+    crate::run::set_gouraud_meshes(gpu, renderer, objects, &look.camera, &names)?;
     let light = Light::Directional {
         dir_to_light_world: Vec3::from(desc.light_dir),
         radiance: Vec3::from(desc.radiance),
@@ -254,22 +325,34 @@ pub(crate) fn run(
     let mut params = RenderParams::default();
     params.uv_scale = Vec2::splat(desc.uv_scale);
     let render_start = Instant::now();
-    let with_btf = render_objects(Some(gpu), &pca, &chosen, &light, &camera, &params)?;
-    let with_plain = render_objects(Some(gpu), &plain, &chosen, &light, &camera, &params)?;
+    let with_btf = scene_frame(gpu, renderer, &pca, &chosen, &frames, &light, look, &params)?;
+    let with_plain = scene_frame(
+        gpu, renderer, &plain, &chosen, &frames, &light, look, &params,
+    )?;
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
+    let display = crate::run::display_for(scene, &with_btf);
+    let left = render::output::to_rgba8(&with_btf, &display, look.background);
+    let right = render::output::to_rgba8(&with_plain, &display, look.background);
+    let (w, h) = (with_btf.width() as usize, with_btf.height() as usize);
+    let mut both = Vec::with_capacity(2 * left.len());
+    for row in 0..h {
+        both.extend_from_slice(&left[row * w * 4..(row + 1) * w * 4]);
+        both.extend_from_slice(&right[row * w * 4..(row + 1) * w * 4]);
+    }
     let path = out_dir.join(&desc.png);
-    crate::strip::write_png(&path, &side_by_side(&with_btf, &with_plain))?;
+    gpu_context::write_rgba8_png(&path, &both, 2 * w as u32, h as u32)?;
     let kept = pca.slots().iter().map(|s| s.components());
     let params = json!({
         "source": source,
-        "objects": chosen.iter().map(|o| o.name.clone()).collect::<Vec<_>>(),
+        "objects": names,
         "size": [pca.width(), pca.height()],
         "components": [kept.clone().min().unwrap_or(0), kept.max().unwrap_or(0)],
         "light_dir": desc.light_dir,
         "uv_scale": desc.uv_scale,
         "material_ms": material_ms,
         "render_ms": render_ms,
-        "image": "left: BTF (§5.5), right: plain texture mapping (frontal normtexture)",
+        "exposure_ev": display.exposure_ev,
+        "image": "left: BTF (§5.5), right: plain texture mapping (frontal normtexture); other objects Gouraud, one depth buffer",
     });
     Ok((vec![path], params))
 }

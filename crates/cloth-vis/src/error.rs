@@ -62,6 +62,9 @@ pub enum Error {
     /// GPU acquisition, rendering or image output failed.
     #[error(transparent)]
     Gpu(#[from] gpu_context::GpuError),
+    /// The renderer refused a frame (camera, mesh, target).
+    #[error(transparent)]
+    Render(#[from] render::RenderError),
     /// An object's frame index is outside its animation.
     #[error(
         "object {object}: frame {frame} is outside the animation's {count} frames (use 0..{count} or -1 for the last)"

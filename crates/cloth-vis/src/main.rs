@@ -25,6 +25,10 @@ enum Command {
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
+        /// Render frames A..B of the scene's animated objects to frame-NNNN.png (overrides
+        /// `[output] frames`).
+        #[arg(long, value_name = "A..B")]
+        frames: Option<render::sequence::FrameRange>,
         /// Hide progress bars.
         #[arg(long)]
         quiet: bool,
@@ -34,6 +38,10 @@ enum Command {
         /// Output folder (created if missing).
         #[arg(long)]
         out: PathBuf,
+        /// Render frames A..B of the cloth animation (120 frames: 0..120) to frame-NNNN.png,
+        /// with the visibility recomputed per frame.
+        #[arg(long, value_name = "A..B")]
+        frames: Option<render::sequence::FrameRange>,
         /// Hide progress bars.
         #[arg(long)]
         quiet: bool,
@@ -369,18 +377,25 @@ enum AnimCommand {
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Render { scene, out, quiet } => {
+        Command::Render {
+            scene,
+            out,
+            frames,
+            quiet,
+        } => {
             let scene = Scene::load(&scene)?;
             let options = RunOptions {
                 progress: !quiet,
+                frames,
                 ..RunOptions::default()
             };
             let output = cloth_vis::run_scene(&scene, &out, &options)?;
             write!(std::io::stdout().lock(), "{}", output.report.table())?;
         }
-        Command::Demo { out, quiet } => {
+        Command::Demo { out, frames, quiet } => {
             let options = RunOptions {
                 progress: !quiet,
+                frames,
                 ..RunOptions::default()
             };
             let output = cloth_vis::run_demo(&out, &options)?;

@@ -87,7 +87,7 @@ impl Plan {
         for effect in &effects {
             stages.extend_from_slice(Stage::needed_by(*effect));
         }
-        if scene.environment.is_some() && scene.output.background == BackgroundDesc::Environment {
+        if scene.environment.is_some() && scene.output.background == BackgroundDesc::ENVIRONMENT {
             stages.push(Stage::Environment);
         }
         stages.sort();

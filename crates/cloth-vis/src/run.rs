@@ -1,24 +1,27 @@
-//! Executing a plan: each stage in order, timed, its parameters recorded in the run report.
+//! Executing a plan: each stage in order, timed, its parameters recorded in the run report; a
+//! still image or, with `[output] frames = "A..B"`, a numbered image sequence of the scene's
+//! animated objects, every frame drawn by one [`render::Renderer`] built once.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{Quat, Vec3};
-use gpu_context::{GpuContext, GpuOptions, HdrImage, Tonemap};
+use gpu_context::{GpuContext, GpuOptions, HdrImage};
 use indicatif::{ProgressBar, ProgressStyle};
+use render::sequence::{FrameRange, frame_file_name};
+use render::tone::{Display, ToneCurve};
+use render::{Background, Camera, DrawMesh, FrameFormat, Renderer, bounding_sphere, output};
 use serde_json::json;
 
 use crate::Error;
-use crate::camera::{Camera, bounding_sphere};
+use crate::object::{Animation, WorldObject};
 use crate::plan::{Plan, Stage};
-use crate::render::{Backdrop, DrawMesh, render};
 use crate::report::{RunReport, StageRecord};
-use crate::scene::{EnvironmentSource, ExposureDesc, GeometrySource, RadianceMethodDesc, Scene};
-
-/// Where automatic exposure puts the 90th percentile of the objects' vertex luminance.
-const AUTO_EXPOSURE_KEY: f32 = 0.8;
-/// Percentile used by automatic exposure.
-const AUTO_EXPOSURE_PERCENTILE: f64 = 0.9;
+use crate::scene::{
+    BackgroundDesc, BackgroundKeyword, EnvironmentSource, ExposureDesc, GROUND_NAME,
+    GeometrySource, RadianceMethodDesc, Scene, ToneDesc,
+};
 
 /// How a scene is run.
 #[derive(Clone, Debug, Default)]
@@ -27,6 +30,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// Adapter choice.
     pub gpu: GpuOptions,
+    /// Render this frame range as an image sequence (overrides the scene's `[output] frames`).
+    pub frames: Option<FrameRange>,
 }
 
 /// What a run produced.
@@ -34,34 +39,13 @@ pub struct RunOptions {
 pub struct RunOutput {
     /// Stages, times and files.
     pub report: RunReport,
-    /// The linear HDR image.
+    /// The linear HDR image (the last frame of a sequence).
     pub image: HdrImage,
     /// The plan that ran.
     pub plan: Plan,
-}
-
-/// One object in world space, with its lighting once computed.
-#[derive(Clone, Debug)]
-pub struct WorldObject {
-    /// Object name.
-    pub name: String,
-    /// World-space positions.
-    pub positions: Vec<Vec3>,
-    /// World-space unit normals (zero for unreferenced vertices).
-    pub normals: Vec<Vec3>,
-    /// Triangles.
-    pub triangles: Vec<[u32; 3]>,
-    /// Texture coordinates, one per position, when the source has them (the synthetic cloth
-    /// and meshes with per-vertex UVs); the `btf` effect needs them.
-    pub uvs: Option<Vec<glam::Vec2>>,
-    /// Albedo ρ.
-    pub albedo: Vec3,
-    /// Lit on both sides.
-    pub two_sided: bool,
-    /// Radiance towards the front side, once the lighting stage ran.
-    pub front: Option<Vec<Vec3>>,
-    /// Radiance towards the back side, once the lighting stage ran.
-    pub back: Option<Vec<Vec3>>,
+    /// Render pipelines built during the run (gpu-context's per-thread count): constant in the
+    /// number of frames, since the renderer builds its pipelines once.
+    pub pipelines_built: u64,
 }
 
 struct Timer {
@@ -85,6 +69,42 @@ impl Timer {
     }
 }
 
+/// Per-frame times of one stage over a sequence.
+#[derive(Clone, Copy, Debug, Default)]
+struct FrameTimes {
+    total_ms: f64,
+    max_ms: f64,
+    frames: usize,
+}
+
+impl FrameTimes {
+    fn add(&mut self, ms: f64) {
+        self.total_ms += ms;
+        self.max_ms = self.max_ms.max(ms);
+        self.frames += 1;
+    }
+
+    fn record(&self, stage: Stage, mut params: serde_json::Value) -> StageRecord {
+        if let serde_json::Value::Object(map) = &mut params {
+            map.insert("frames".into(), json!(self.frames));
+            map.insert(
+                "mean_ms_per_frame".into(),
+                json!(self.total_ms / self.frames.max(1) as f64),
+            );
+            map.insert("max_ms_per_frame".into(), json!(self.max_ms));
+        }
+        StageRecord {
+            stage: stage.name().to_owned(),
+            millis: self.total_ms,
+            params,
+        }
+    }
+}
+
+fn ms_since(start: Instant) -> f64 {
+    start.elapsed().as_secs_f64() * 1e3
+}
+
 /// Validate, plan and run `scene`, writing its images and run report into `out_dir`.
 ///
 /// Every check that needs no work (effects, values, files) happens before any stage starts,
@@ -95,7 +115,12 @@ impl Timer {
 /// Any [`Error`]; files already written by this run are complete (each is written atomically).
 pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<RunOutput, Error> {
     let start = Instant::now();
+    let pipelines_before = gpu_context::PipelineStats::on_this_thread().render_pipelines;
     let plan = Plan::for_scene(scene)?;
+    let frames = match options.frames {
+        Some(range) => Some(range),
+        None => scene.frame_range()?,
+    };
     std::fs::create_dir_all(out_dir).map_err(|e| Error::Io {
         path: out_dir.to_owned(),
         reason: e.to_string(),
@@ -104,54 +129,86 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
     let mut timer = Timer { stages: Vec::new() };
 
     let mut objects = timer.run(Stage::Geometry, || load_geometry(scene, options.progress))?;
+    if let Some(range) = frames {
+        check_range(scene, &objects, range)?;
+    }
+    // The camera frames the objects (over the whole range for a sequence), not the ground.
+    let camera = frame_camera(scene, &objects, frames);
+    if let Some(ground) = &scene.ground {
+        objects.push(ground_object(ground, &objects, frames));
+    }
 
     let environment = if plan.contains(Stage::Environment) {
         Some(timer.run(Stage::Environment, || load_environment(scene))?)
     } else {
         None
     };
-
-    if plan.contains(Stage::Lighting) {
+    let lights = if plan.contains(Stage::LightDirections) {
         let env = environment.as_ref().ok_or_else(|| Error::Scene {
             origin: scene.origin.clone(),
             message: "lighting planned without an environment".to_owned(),
         })?;
-        let (sphere, radiance) =
-            timer.run(Stage::LightDirections, || light_directions(scene, env))?;
-        let visibility = if plan.contains(Stage::Visibility) {
-            Some(timer.run(Stage::Visibility, || {
-                crate::shadowing::visibility(scene, &gpu, &objects, &sphere)
-            })?)
-        } else {
-            None
-        };
-        timer.run(Stage::Lighting, || {
-            let vertices = crate::shadowing::light_objects(
-                &mut objects,
-                &sphere,
-                &radiance,
-                visibility.as_ref(),
-            )?;
-            let params = json!({
-                "vertices": vertices,
-                "directions": sphere.len(),
-                "visibility": visibility.is_some(),
-            });
-            Ok(((), params))
-        })?;
+        Some(timer.run(Stage::LightDirections, || light_directions(scene, env))?)
+    } else {
+        None
+    };
+
+    let format = FrameFormat::for_context(&gpu);
+    let mut renderer = Renderer::new(&gpu.device, format);
+    let background = background(scene, environment.is_some());
+    if background == Background::Environment {
+        renderer.backdrop.set_environment(
+            &gpu.device,
+            environment.as_ref().map(|env| render::Backdrop {
+                width: env.width(),
+                height: env.height(),
+                texels: env.texels(),
+                world_from_env: env.world_from_env(),
+            }),
+        );
     }
+    let look = Look {
+        camera,
+        background,
+        adapter: gpu.summary().to_string(),
+        samples: format.samples,
+    };
 
     let mut outputs = Vec::new();
-    let image = timer.run(Stage::Render, || {
-        let (image, params, written) =
-            render_stage(scene, out_dir, &gpu, &objects, environment.as_ref())?;
-        outputs = written;
-        Ok((image, params))
-    })?;
+    let image = match frames {
+        None => {
+            if let Some(lights) = &lights {
+                light_frame(scene, &plan, &gpu, &mut objects, lights, &mut timer)?;
+            }
+            timer.run(Stage::Render, || {
+                let (image, params, written) =
+                    render_still(scene, out_dir, &gpu, &mut renderer, &objects, &look)?;
+                outputs = written;
+                Ok((image, params))
+            })?
+        }
+        Some(range) => {
+            let (image, written) = render_sequence(
+                scene,
+                out_dir,
+                &gpu,
+                &plan,
+                &mut renderer,
+                &mut objects,
+                lights.as_ref(),
+                &look,
+                range,
+                options.progress,
+                &mut timer,
+            )?;
+            outputs = written;
+            image
+        }
+    };
 
     if plan.contains(Stage::Btf) {
         let written = timer.run(Stage::Btf, || {
-            crate::btf_stage::run(scene, out_dir, &gpu, &objects)
+            crate::btf_stage::run(scene, out_dir, &gpu, &mut renderer, &objects, &look)
         })?;
         outputs.extend(written);
     }
@@ -164,13 +221,149 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         total_millis: 0.0,
         outputs,
     };
-    report.total_millis = start.elapsed().as_secs_f64() * 1e3;
+    report.total_millis = ms_since(start);
     let (json_path, text_path) = report.write(out_dir)?;
     report.outputs.extend([json_path, text_path]);
     Ok(RunOutput {
         report,
         image,
         plan,
+        pipelines_built: gpu_context::PipelineStats::on_this_thread().render_pipelines
+            - pipelines_before,
+    })
+}
+
+/// What every image of a run shares: the camera, the background and where it was drawn.
+#[derive(Clone, Debug)]
+pub(crate) struct Look {
+    /// The camera (fixed over a sequence).
+    pub camera: Camera,
+    /// The background.
+    pub background: Background,
+    /// The adapter, for reports.
+    pub adapter: String,
+    /// MSAA samples of the frame.
+    pub samples: u32,
+}
+
+/// The background a scene asks for; `environment` without an environment is black.
+fn background(scene: &Scene, has_environment: bool) -> Background {
+    match scene.output.background {
+        BackgroundDesc::Named(BackgroundKeyword::Environment) if has_environment => {
+            Background::Environment
+        }
+        BackgroundDesc::Named(BackgroundKeyword::Environment | BackgroundKeyword::Black) => {
+            Background::Color([0.0; 3])
+        }
+        BackgroundDesc::Named(BackgroundKeyword::Transparent) => Background::Transparent,
+        BackgroundDesc::Color(c) => Background::Color(c),
+    }
+}
+
+/// The scene's camera: framed on the objects' bounding sphere (over every frame of `range`
+/// for a sequence, so the camera holds still).
+fn frame_camera(scene: &Scene, objects: &[WorldObject], range: Option<FrameRange>) -> Camera {
+    let points: Vec<Vec3> = match range {
+        None => objects.iter().flat_map(|o| o.positions.clone()).collect(),
+        Some(r) => objects
+            .iter()
+            .flat_map(|o| match &o.animation {
+                None => o.positions.clone(),
+                Some(a) => a.frames[r.start..r.end]
+                    .iter()
+                    .flatten()
+                    .map(|p| a.world_from_object.transform_point3(*p))
+                    .collect(),
+            })
+            .collect(),
+    };
+    let (centre, radius) = bounding_sphere(&points).unwrap_or((Vec3::ZERO, 1.0));
+    crate::camera::resolve(&scene.camera, centre, radius)
+}
+
+/// A ground grid under the objects: at their lowest point (over the range), centred under
+/// their bounding sphere, `size` radii wide.
+fn ground_object(
+    desc: &crate::scene::GroundDesc,
+    objects: &[WorldObject],
+    range: Option<FrameRange>,
+) -> WorldObject {
+    let points: Vec<Vec3> = objects
+        .iter()
+        .flat_map(|o| match range {
+            Some(_) => o.all_world_positions(),
+            None => o.positions.clone(),
+        })
+        .collect();
+    let (centre, radius) = bounding_sphere(&points).unwrap_or((Vec3::ZERO, 1.0));
+    let height = points.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
+    let height = if height.is_finite() { height } else { 0.0 };
+    let (positions, triangles, uvs) =
+        render::ground::ground_grid(centre, height, desc.size * radius.max(1e-3), desc.cells);
+    let normals = vec![Vec3::Y; positions.len()];
+    WorldObject {
+        name: GROUND_NAME.to_owned(),
+        positions,
+        normals,
+        triangles,
+        uvs: Some(uvs),
+        albedo: Vec3::from(desc.albedo),
+        two_sided: false,
+        front: None,
+        back: None,
+        animation: None,
+    }
+}
+
+/// Every animated object must hold the range; at least one object must be animated.
+fn check_range(scene: &Scene, objects: &[WorldObject], range: FrameRange) -> Result<(), Error> {
+    let animated: Vec<&WorldObject> = objects.iter().filter(|o| o.animation.is_some()).collect();
+    if animated.is_empty() {
+        return Err(Error::Scene {
+            origin: scene.origin.clone(),
+            message: format!(
+                "output.frames = {range}: no object is animated (use an animation source: \
+                 synth:cloth, .npy, an OBJ frame folder or an animated glTF)"
+            ),
+        });
+    }
+    for o in animated {
+        range.check(o.frame_count()).map_err(|m| Error::Scene {
+            origin: scene.origin.clone(),
+            message: format!("output.frames for object {:?}: {m}", o.name),
+        })?;
+    }
+    Ok(())
+}
+
+/// The lightsphere and I_j per direction.
+type Lights = (lightsphere::Lightsphere, Vec<Vec3>);
+
+/// Visibility (when planned) and lighting of the objects as posed, recorded as stages.
+fn light_frame(
+    scene: &Scene,
+    plan: &Plan,
+    gpu: &GpuContext,
+    objects: &mut [WorldObject],
+    (sphere, radiance): &Lights,
+    timer: &mut Timer,
+) -> Result<(), Error> {
+    let visibility = if plan.contains(Stage::Visibility) {
+        Some(timer.run(Stage::Visibility, || {
+            crate::shadowing::visibility(scene, gpu, objects, sphere)
+        })?)
+    } else {
+        None
+    };
+    timer.run(Stage::Lighting, || {
+        let vertices =
+            crate::shadowing::light_objects(objects, sphere, radiance, visibility.as_ref())?;
+        let params = json!({
+            "vertices": vertices,
+            "directions": sphere.len(),
+            "visibility": visibility.is_some(),
+        });
+        Ok(((), params))
     })
 }
 
@@ -212,14 +405,23 @@ fn load_geometry(
         let anim =
             synth::simulate_cloth_with_progress(&p, &mut |done, _| bar.set_position(done as u64))?;
         bar.finish_and_clear();
-        Some(anim)
+        Some(SharedCloth {
+            frames: Arc::new(anim.frames),
+            triangles: anim.triangles,
+            uvs: anim.uvs,
+            grid: anim.grid,
+            obstacle: anim.obstacle,
+        })
     } else {
         None
     };
     let mut objects = Vec::with_capacity(scene.objects.len());
     let mut params = serde_json::Map::new();
     for (index, desc) in scene.objects.iter().enumerate() {
-        let (positions, triangles, uvs, detail) = match (scene.geometry_source(index)?, &cloth) {
+        let (positions, triangles, uvs, detail, animation) = match (
+            scene.geometry_source(index)?,
+            &cloth,
+        ) {
             (GeometrySource::SynthCloth, Some(anim)) => {
                 let frame = frame_index(&desc.name, desc.frame, anim.frames.len())?;
                 let detail = json!({ "source": "synth:cloth", "frame": frame, "frames": anim.frames.len(), "grid": anim.grid });
@@ -228,9 +430,18 @@ fn load_geometry(
                     anim.triangles.clone(),
                     Some(anim.uvs.clone()),
                     detail,
+                    Some(Arc::clone(&anim.frames)),
                 )
             }
-            (GeometrySource::SynthCloth, None) => unreachable!("uses_cloth is true for this scene"),
+            (GeometrySource::SynthCloth, None) => {
+                return Err(Error::Scene {
+                    origin: scene.origin.clone(),
+                    message: format!(
+                        "object {:?}: the synthetic cloth was not simulated",
+                        desc.name
+                    ),
+                });
+            }
             (GeometrySource::SynthClothObstacle, _) => {
                 let obstacle = cloth
                     .as_ref()
@@ -241,6 +452,7 @@ fn load_geometry(
                     triangles,
                     None,
                     json!({ "source": "synth:cloth-obstacle" }),
+                    None,
                 )
             }
             (GeometrySource::File(path), _) => load_file(&path, desc)?,
@@ -268,6 +480,10 @@ fn load_geometry(
             two_sided: desc.two_sided,
             front: None,
             back: None,
+            animation: animation.map(|frames| Animation {
+                frames,
+                world_from_object,
+            }),
         });
     }
     Ok((objects, serde_json::Value::Object(params)))
@@ -292,13 +508,24 @@ fn frame_index(object: &str, frame: i64, count: usize) -> Result<usize, Error> {
     Ok(resolved as usize)
 }
 
-/// Positions, triangles, UVs (when the file has them) and what the report says of the input.
+/// Positions, triangles, UVs (when the file has them), what the report says of the input, and
+/// the object-space frames of an animation.
 type Geometry = (
     Vec<Vec3>,
     Vec<[u32; 3]>,
     Option<Vec<glam::Vec2>>,
     serde_json::Value,
+    Option<Arc<Vec<Vec<Vec3>>>>,
 );
+
+/// The simulated cloth, its frames shared by every object that shows it.
+struct SharedCloth {
+    frames: Arc<Vec<Vec<Vec3>>>,
+    triangles: Vec<[u32; 3]>,
+    uvs: Vec<glam::Vec2>,
+    grid: usize,
+    obstacle: synth::Obstacle,
+}
 
 fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, Error> {
     let has_ext = |ext: &str| {
@@ -326,7 +553,8 @@ fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, E
             "degenerate_triangles": report.degenerate_triangles.len(),
         });
         let positions = anim.frames[frame].clone();
-        return Ok((positions, anim.triangles, anim.uvs, detail));
+        let frames = Arc::new(anim.frames);
+        return Ok((positions, anim.triangles, anim.uvs, detail, Some(frames)));
     }
     let (mesh, report) = meshio::load_mesh(path, &meshio::LoadOptions::default())?;
     let detail = json!({
@@ -335,7 +563,7 @@ fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, E
         "degenerate_triangles": report.degenerate_triangles.len(),
         "duplicate_positions": report.duplicate_positions,
     });
-    Ok((mesh.positions, mesh.triangles, mesh.uvs, detail))
+    Ok((mesh.positions, mesh.triangles, mesh.uvs, detail, None))
 }
 
 fn load_environment(scene: &Scene) -> Result<(lightsphere::Environment, serde_json::Value), Error> {
@@ -434,41 +662,20 @@ fn preview_shading(object: &WorldObject, eye: Vec3) -> Vec<Vec3> {
         .collect()
 }
 
-fn luminance(c: Vec3) -> f32 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
-
-fn auto_exposure(objects: &[WorldObject], colors: &[(Vec<Vec3>, Vec<Vec3>)]) -> f32 {
-    let mut lum: Vec<f32> = colors
-        .iter()
-        .zip(objects)
-        .flat_map(|((f, _), o)| {
-            f.iter()
-                .zip(&o.normals)
-                .filter(|(_, n)| **n != Vec3::ZERO)
-                .map(|(c, _)| luminance(*c))
-        })
-        .filter(|l| l.is_finite() && *l > 0.0)
-        .collect();
-    if lum.is_empty() {
-        return 1.0;
-    }
-    let k = ((lum.len() - 1) as f64 * AUTO_EXPOSURE_PERCENTILE) as usize;
-    let (_, key, _) = lum.select_nth_unstable_by(k, f32::total_cmp);
-    AUTO_EXPOSURE_KEY / *key
-}
-
-fn render_stage(
-    scene: &Scene,
-    out_dir: &Path,
+/// Hand the objects' current positions and radiance to the Gouraud pass (in place when the
+/// topology is unchanged), skipping `except` (objects another pass draws).
+pub(crate) fn set_gouraud_meshes(
     gpu: &GpuContext,
+    renderer: &mut Renderer,
     objects: &[WorldObject],
-    environment: Option<&lightsphere::Environment>,
-) -> Result<(HdrImage, serde_json::Value, Vec<PathBuf>), Error> {
-    let (centre, radius) = bounding_sphere(objects.iter().flat_map(|o| o.positions.iter()))
-        .unwrap_or((Vec3::ZERO, 1.0));
-    let camera = Camera::frame(&scene.camera, centre, radius);
-    let colors: Vec<(Vec<Vec3>, Vec<Vec3>)> = objects
+    camera: &Camera,
+    except: &[&str],
+) -> Result<(), Error> {
+    let drawn: Vec<&WorldObject> = objects
+        .iter()
+        .filter(|o| !except.contains(&o.name.as_str()))
+        .collect();
+    let colors: Vec<(Vec<Vec3>, Vec<Vec3>)> = drawn
         .iter()
         .map(|o| match (&o.front, &o.back) {
             (Some(f), Some(b)) => (f.clone(), b.clone()),
@@ -478,7 +685,7 @@ fn render_stage(
             }
         })
         .collect();
-    let meshes: Vec<DrawMesh<'_>> = objects
+    let meshes: Vec<DrawMesh<'_>> = drawn
         .iter()
         .zip(&colors)
         .map(|(o, (f, b))| DrawMesh {
@@ -488,39 +695,172 @@ fn render_stage(
             back: b,
         })
         .collect();
-    let backdrop = environment.map(|env| Backdrop {
-        width: env.width(),
-        height: env.height(),
-        texels: env.texels(),
-        world_from_env: env.world_from_env(),
-    });
-    let image = render(&gpu.device, &gpu.queue, &camera, &meshes, backdrop)?;
-    let exposure = match scene.output.exposure {
-        ExposureDesc::Fixed(x) => x,
-        ExposureDesc::Auto(_) => auto_exposure(objects, &colors),
+    renderer
+        .gouraud
+        .set_meshes(&gpu.device, &gpu.queue, &meshes)?;
+    Ok(())
+}
+
+/// The display mapping of a scene for `image`: fixed EV, or automatic from the objects'
+/// pixels (the backdrop never counts).
+pub(crate) fn display_for(scene: &Scene, image: &HdrImage) -> Display {
+    let exposure_ev = match scene.output.exposure {
+        ExposureDesc::Fixed(ev) => ev,
+        ExposureDesc::Auto(_) => output::auto_exposure(image),
     };
-    let tonemap = Tonemap {
-        exposure,
-        gamma: scene.output.gamma,
+    let curve = match scene.output.tone {
+        ToneDesc::Aces => ToneCurve::AcesFitted,
+        ToneDesc::Clamp => ToneCurve::Clamp {
+            gamma: scene.output.gamma,
+        },
     };
+    Display { exposure_ev, curve }
+}
+
+/// Write `image` as the scene's PNG and/or EXR names (`png`, `exr`); returns the paths.
+pub(crate) fn write_images(
+    image: &HdrImage,
+    display: &Display,
+    background: Background,
+    png: Option<PathBuf>,
+    exr: Option<PathBuf>,
+) -> Result<Vec<PathBuf>, Error> {
     let mut written = Vec::new();
-    if let Some(name) = &scene.output.png {
-        let path = out_dir.join(name);
-        image.write_png(&path, &tonemap)?;
+    if let Some(path) = png {
+        output::write_png(image, &path, display, background)?;
         written.push(path);
     }
-    if let Some(name) = &scene.output.exr {
-        let path = out_dir.join(name);
-        image.write_exr(&path)?;
+    if let Some(path) = exr {
+        output::write_exr(image, &path, background)?;
         written.push(path);
     }
+    Ok(written)
+}
+
+fn render_still(
+    scene: &Scene,
+    out_dir: &Path,
+    gpu: &GpuContext,
+    renderer: &mut Renderer,
+    objects: &[WorldObject],
+    look: &Look,
+) -> Result<(HdrImage, serde_json::Value, Vec<PathBuf>), Error> {
+    set_gouraud_meshes(gpu, renderer, objects, &look.camera, &[])?;
+    let image = renderer.render(&gpu.device, &gpu.queue, &look.camera, look.background, &[])?;
+    let display = display_for(scene, &image);
+    let written = write_images(
+        &image,
+        &display,
+        look.background,
+        scene.output.png.as_ref().map(|n| out_dir.join(n)),
+        scene.output.exr.as_ref().map(|n| out_dir.join(n)),
+    )?;
     let params = json!({
-        "width": camera.width,
-        "height": camera.height,
-        "adapter": gpu.summary().to_string(),
-        "exposure": exposure,
-        "gamma": scene.output.gamma,
-        "eye": camera.eye.to_array(),
+        "width": look.camera.width,
+        "height": look.camera.height,
+        "adapter": look.adapter,
+        "msaa_samples": look.samples,
+        "exposure_ev": display.exposure_ev,
+        "tone": scene.output.tone,
+        "background": scene.output.background,
+        "eye": look.camera.eye.to_array(),
     });
     Ok((image, params, written))
+}
+
+/// The frames of `range`: pose, visibility, lighting, render, write — one renderer, buffers
+/// rewritten in place. Exposure is fixed on the first frame (automatic exposure per frame
+/// would flicker).
+#[allow(clippy::too_many_arguments)]
+fn render_sequence(
+    scene: &Scene,
+    out_dir: &Path,
+    gpu: &GpuContext,
+    plan: &Plan,
+    renderer: &mut Renderer,
+    objects: &mut [WorldObject],
+    lights: Option<&Lights>,
+    look: &Look,
+    range: FrameRange,
+    progress: bool,
+    timer: &mut Timer,
+) -> Result<(HdrImage, Vec<PathBuf>), Error> {
+    let bar = progress_bar(progress, range.len() as u64, "rendering frames");
+    let (mut pose_t, mut vis_t, mut light_t, mut render_t, mut write_t) = Default::default();
+    let (mut vis_params, mut light_params) = (json!({}), json!({}));
+    let mut display: Option<Display> = None;
+    let mut written = Vec::new();
+    let mut last = None;
+    for f in range.iter() {
+        let t = Instant::now();
+        for o in objects.iter_mut() {
+            o.pose(f);
+        }
+        FrameTimes::add(&mut pose_t, ms_since(t));
+        if let Some((sphere, radiance)) = lights {
+            let visibility = if plan.contains(Stage::Visibility) {
+                let t = Instant::now();
+                let (v, p) = crate::shadowing::visibility(scene, gpu, objects, sphere)?;
+                FrameTimes::add(&mut vis_t, ms_since(t));
+                vis_params = p;
+                Some(v)
+            } else {
+                None
+            };
+            let t = Instant::now();
+            let vertices =
+                crate::shadowing::light_objects(objects, sphere, radiance, visibility.as_ref())?;
+            FrameTimes::add(&mut light_t, ms_since(t));
+            light_params = json!({ "vertices": vertices, "directions": sphere.len() });
+        }
+        let t = Instant::now();
+        set_gouraud_meshes(gpu, renderer, objects, &look.camera, &[])?;
+        let image = renderer.render(&gpu.device, &gpu.queue, &look.camera, look.background, &[])?;
+        FrameTimes::add(&mut render_t, ms_since(t));
+        let t = Instant::now();
+        let d = *display.get_or_insert_with(|| display_for(scene, &image));
+        let png = Some(out_dir.join(frame_file_name("frame", f, "png")));
+        let exr = scene
+            .output
+            .sequence_exr
+            .then(|| out_dir.join(frame_file_name("frame", f, "exr")));
+        written.extend(write_images(&image, &d, look.background, png, exr)?);
+        FrameTimes::add(&mut write_t, ms_since(t));
+        last = Some(image);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let times: [(Stage, &FrameTimes, serde_json::Value); 4] = [
+        (
+            Stage::Geometry,
+            &pose_t,
+            json!({ "what": "pose and normals per frame" }),
+        ),
+        (Stage::Visibility, &vis_t, vis_params),
+        (Stage::Lighting, &light_t, light_params),
+        (
+            Stage::Render,
+            &render_t,
+            json!({
+                "width": look.camera.width,
+                "height": look.camera.height,
+                "adapter": look.adapter,
+                "msaa_samples": look.samples,
+                "exposure_ev": display.map(|d| d.exposure_ev),
+                "range": range.to_string(),
+                "gpu_mesh_allocations": renderer.gouraud.allocations(),
+                "write_mean_ms_per_frame": write_t.total_ms / write_t.frames.max(1) as f64,
+            }),
+        ),
+    ];
+    for (stage, t, params) in times {
+        if t.frames > 0 {
+            timer.stages.push(t.record(stage, params));
+        }
+    }
+    let image = last.ok_or_else(|| Error::Scene {
+        origin: scene.origin.clone(),
+        message: format!("output.frames = {range} holds no frame"),
+    })?;
+    Ok((image, written))
 }

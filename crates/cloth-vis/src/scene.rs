@@ -40,6 +40,8 @@ pub const SYNTH_PREFIX: &str = "synth:";
 pub const MAX_LEVEL: u32 = 7;
 /// Largest image side a scene may ask for.
 pub const MAX_IMAGE_SIDE: u32 = 8192;
+/// The name of the `[ground]` object in reports and `[btf] objects`.
+pub const GROUND_NAME: &str = "ground";
 
 /// A parsed scene file.
 #[derive(Clone, Debug, Deserialize)]
@@ -74,6 +76,8 @@ pub struct Scene {
     /// The BTF material (the `btf` effect).
     #[serde(default)]
     pub btf: BtfDesc,
+    /// An optional ground plane under the objects.
+    pub ground: Option<GroundDesc>,
     /// Folder that relative paths are resolved against (the scene file's folder).
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -295,11 +299,12 @@ impl Default for CameraDesc {
     }
 }
 
-/// Exposure: a multiplier, or `"auto"` (the 90th percentile of the objects' radiance maps to 0.8).
+/// Exposure: stops (EV; radiance is multiplied by 2^EV before the tone curve), or `"auto"`
+/// (the 90th percentile of the objects' pixel luminance — never the backdrop's — maps to 0.8).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, serde::Serialize)]
 #[serde(untagged)]
 pub enum ExposureDesc {
-    /// A fixed multiplier.
+    /// A fixed exposure in EV.
     Fixed(f32),
     /// `"auto"`.
     Auto(AutoKeyword),
@@ -313,15 +318,80 @@ pub enum AutoKeyword {
     Auto,
 }
 
-/// What is drawn behind the objects.
+/// What is drawn behind the objects: `"environment"` (default; black without one),
+/// `"black"`, `"transparent"` (PNG and EXR carry the objects' coverage as alpha), or a linear
+/// colour `[r, g, b]`.
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize, serde::Serialize)]
+#[serde(untagged)]
+pub enum BackgroundDesc {
+    /// A keyword.
+    Named(BackgroundKeyword),
+    /// A constant linear colour.
+    Color([f32; 3]),
+}
+
+impl Default for BackgroundDesc {
+    fn default() -> Self {
+        Self::Named(BackgroundKeyword::Environment)
+    }
+}
+
+impl BackgroundDesc {
+    /// The environment as the backdrop.
+    pub const ENVIRONMENT: Self = Self::Named(BackgroundKeyword::Environment);
+    /// Black.
+    pub const BLACK: Self = Self::Named(BackgroundKeyword::Black);
+    /// Transparent (alpha matte).
+    pub const TRANSPARENT: Self = Self::Named(BackgroundKeyword::Transparent);
+}
+
+/// The background keywords.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BackgroundKeyword {
+    /// The environment map as seen by the camera.
+    Environment,
+    /// Black, opaque.
+    Black,
+    /// Nothing: alpha 0.
+    Transparent,
+}
+
+/// The tone curve of the PNG output (`render::tone`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
-pub enum BackgroundDesc {
-    /// The environment map as seen by the camera (black without an environment).
+pub enum ToneDesc {
+    /// Narkowicz's ACES fit, then sRGB (default).
     #[default]
-    Environment,
-    /// Black.
-    Black,
+    Aces,
+    /// The seed's clamp then x^(1/gamma).
+    Clamp,
+}
+
+/// An optional ground plane under the scene: a real object that receives and casts
+/// visibility like any other (`render::ground`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroundDesc {
+    /// Diffuse albedo (linear RGB in [0, 1]).
+    #[serde(default = "default_ground_albedo")]
+    pub albedo: [f32; 3],
+    /// Side of the square as a multiple of the scene's bounding-sphere radius.
+    #[serde(default = "default_ground_size")]
+    pub size: f32,
+    /// Grid cells per side (the resolution of the shadows it receives per vertex).
+    #[serde(default = "default_ground_cells")]
+    pub cells: u32,
+}
+
+fn default_ground_albedo() -> [f32; 3] {
+    [0.5, 0.5, 0.5]
+}
+fn default_ground_size() -> f32 {
+    5.0
+}
+fn default_ground_cells() -> u32 {
+    64
 }
 
 /// Image outputs, written into the output folder.
@@ -343,6 +413,16 @@ pub struct OutputDesc {
     /// Background.
     #[serde(default)]
     pub background: BackgroundDesc,
+    /// Tone curve.
+    #[serde(default)]
+    pub tone: ToneDesc,
+    /// A frame range `"A..B"` of the scene's animated objects, rendered to a numbered
+    /// sequence `frame-0000.png`, … (`png`/`exr` name the still when omitted).
+    #[serde(default)]
+    pub frames: Option<String>,
+    /// Also write `frame-NNNN.exr` for each frame of a sequence.
+    #[serde(default)]
+    pub sequence_exr: bool,
 }
 
 fn default_png() -> Option<String> {
@@ -366,6 +446,9 @@ impl Default for OutputDesc {
             exposure: default_exposure(),
             gamma: default_gamma(),
             background: BackgroundDesc::default(),
+            tone: ToneDesc::default(),
+            frames: None,
+            sequence_exr: false,
         }
     }
 }
@@ -638,6 +721,21 @@ impl Scene {
         }
     }
 
+    /// The `[output] frames` range, parsed (its end is checked against the animation later).
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming `output.frames` and the text.
+    pub fn frame_range(&self) -> Result<Option<render::sequence::FrameRange>, Error> {
+        self.output
+            .frames
+            .as_deref()
+            .map(|text| {
+                text.parse()
+                    .map_err(|e: String| self.invalid("output.frames", e))
+            })
+            .transpose()
+    }
+
     /// Check everything that can be checked without doing the work: effect names and
     /// availability, value ranges, and that every named file exists.
     ///
@@ -755,10 +853,38 @@ impl Scene {
             ));
         }
         if let ExposureDesc::Fixed(x) = self.output.exposure {
-            if !(x.is_finite() && x > 0.0) {
+            if !(x.is_finite() && x.abs() <= 64.0) {
                 return Err(self.invalid(
                     "output.exposure",
-                    format!("{x} must be finite and > 0, or \"auto\""),
+                    format!("{x} EV must be finite and within ±64, or \"auto\""),
+                ));
+            }
+        }
+        if let BackgroundDesc::Color(c) = self.output.background {
+            if !c.iter().all(|v| v.is_finite() && *v >= 0.0) {
+                return Err(self.invalid(
+                    "output.background",
+                    format!("{c:?}: a colour needs finite linear values ≥ 0"),
+                ));
+            }
+        }
+        self.frame_range()?;
+        if let Some(g) = &self.ground {
+            if let Some(c) = g.albedo.iter().find(|c| !(0.0..=1.0).contains(*c)) {
+                return Err(self.invalid("ground.albedo", format!("{c} is outside [0, 1]")));
+            }
+            if !(g.size.is_finite() && g.size > 0.0 && g.size <= 1e4) {
+                return Err(self.invalid("ground.size", format!("{} is outside (0, 1e4]", g.size)));
+            }
+            if !(1..=1024).contains(&g.cells) {
+                return Err(
+                    self.invalid("ground.cells", format!("{} is outside 1..=1024", g.cells))
+                );
+            }
+            if self.objects.iter().any(|o| o.name == GROUND_NAME) {
+                return Err(self.invalid(
+                    "ground",
+                    format!("an [[object]] is already named {GROUND_NAME:?}; rename it"),
                 ));
             }
         }

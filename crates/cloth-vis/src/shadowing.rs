@@ -13,7 +13,7 @@ use occlusion_gpu::{
 use serde_json::json;
 
 use crate::Error;
-use crate::run::WorldObject;
+use crate::object::WorldObject;
 use crate::scene::{Scene, VisibilityBackendDesc};
 
 /// M for every object (and for the flipped side of two-sided ones), with the row ranges.

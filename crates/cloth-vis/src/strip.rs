@@ -3,7 +3,8 @@
 //! pose and place from panel to panel (the way the thesis shows generated sequences, Figs.
 //! 3.7–3.10).
 //!
-//! Each panel is one call of the renderer ([`crate::render`]); the shading is a fixed key light
+//! One [`render::Renderer`] draws every panel (its pipelines are built once per strip, not per
+//! panel; the mesh buffers are rewritten in place); the shading is a fixed key light
 //! plus ambient on a grey Lambertian surface, two-sided, with normals computed from the
 //! triangles of each frame (the clips carry none). The panels are tone-mapped with gamma 2.2
 //! and copied into one RGBA8 image.
@@ -12,11 +13,10 @@ use std::io::Write as _;
 use std::path::Path;
 
 use glam::Vec3;
-use gpu_context::Tonemap;
+use render::tone::{Display, ToneCurve};
+use render::{Background, DrawMesh, FrameFormat, Renderer, bounding_sphere};
 
 use crate::Error;
-use crate::camera::{Camera, bounding_sphere};
-use crate::render::{DrawMesh, render};
 use crate::scene::CameraDesc;
 
 /// Panels in a strip when not given (`--strip-frames`).
@@ -144,7 +144,7 @@ pub fn render_strip(
         bounding_sphere(frames.iter().flat_map(|f| used.iter().map(move |&i| &f[i])))
             .unwrap_or((Vec3::ZERO, 1.0));
     let [width, height] = panel_size;
-    let camera = Camera::frame(
+    let camera = crate::camera::resolve(
         &CameraDesc {
             width,
             height,
@@ -153,7 +153,12 @@ pub fn render_strip(
         centre,
         radius,
     );
-    let tonemap = Tonemap::default();
+    // The seed's display mapping: the strip's shading is bounded by 1, no filmic curve needed.
+    let display = Display {
+        exposure_ev: 0.0,
+        curve: ToneCurve::Clamp { gamma: 2.2 },
+    };
+    let mut renderer = Renderer::new(device, FrameFormat::single_sample(device));
     let mut strip = image::RgbaImage::new(width * count as u32, height);
     for (panel, &index) in strip_frame_indices(frames.len(), count).iter().enumerate() {
         let positions = &frames[index];
@@ -175,8 +180,10 @@ pub fn render_strip(
             front: &front,
             back: &back,
         };
-        let image = render(device, queue, &camera, &[mesh], None)?;
-        let rgba = image.to_rgba8(&tonemap);
+        renderer.gouraud.set_meshes(device, queue, &[mesh])?;
+        let background = Background::Color([0.0; 3]);
+        let image = renderer.render(device, queue, &camera, background, &[])?;
+        let rgba = render::output::to_rgba8(&image, &display, background);
         let x0 = panel as u32 * width;
         for (i, px) in rgba.chunks_exact(4).enumerate() {
             let (x, y) = (i as u32 % width, i as u32 / width);

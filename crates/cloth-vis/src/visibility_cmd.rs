@@ -35,12 +35,12 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use glam::{DQuat, Quat, Vec3};
-use gpu_context::{GpuContext, HdrImage, Tonemap};
+use gpu_context::{GpuContext, HdrImage};
 use occlusion_gpu::{Backend, DepthParams, VisibilityEngine, VisibilityParams};
+use render::tone::{Display, ToneCurve};
+use render::{Backdrop, Background, DrawMesh, FrameFormat, Renderer, bounding_sphere};
 
 use crate::Error;
-use crate::camera::{Camera, bounding_sphere};
-use crate::render::{Backdrop, DrawMesh, render};
 use crate::scene::CameraDesc;
 
 /// Where automatic exposure puts the 90th percentile of the used vertices' luminance.
@@ -391,19 +391,20 @@ pub fn run_visibility(
         let image = render_vertices(request, gpu, positions, &triangles, c)?;
         match kind {
             ImageKind::Png => {
-                let exposure = match request.exposure_ev {
-                    Some(ev) => ev.exp2(),
-                    None => auto_exposure(c, m.normals()),
+                let exposure_ev = match request.exposure_ev {
+                    Some(ev) => ev,
+                    None => auto_exposure(c, m.normals()).log2(),
                 };
-                image.write_png(
-                    path,
-                    &Tonemap {
-                        exposure,
+                // `--gamma` keeps the seed's clamp-then-gamma mapping for this command.
+                let display = Display {
+                    exposure_ev,
+                    curve: ToneCurve::Clamp {
                         gamma: request.gamma,
                     },
-                )?;
+                };
+                render::output::write_png(&image, path, &display, Background::Environment)?;
             }
-            ImageKind::Exr => image.write_exr(path)?,
+            ImageKind::Exr => render::output::write_exr(&image, path, Background::Environment)?,
         }
     }
     Ok(VisibilitySummary {
@@ -480,7 +481,7 @@ fn render_vertices(
         height: request.render_size[1],
         ..CameraDesc::default()
     };
-    let camera = Camera::frame(&desc, centre, radius);
+    let camera = crate::camera::resolve(&desc, centre, radius);
     let colours: Vec<Vec3> = c
         .iter()
         .map(|v| if v.is_finite() { *v } else { Vec3::ZERO })
@@ -497,7 +498,17 @@ fn render_vertices(
         texels: env.texels(),
         world_from_env: env_rotation(request.env_rotation_deg) * env.world_from_env(),
     });
-    Ok(render(&gpu.device, &gpu.queue, &camera, &[mesh], backdrop)?)
+    let mut renderer = Renderer::new(&gpu.device, FrameFormat::for_context(gpu));
+    let background = if backdrop.is_some() {
+        Background::Environment
+    } else {
+        Background::Color([0.0; 3])
+    };
+    renderer.backdrop.set_environment(&gpu.device, backdrop);
+    renderer
+        .gouraud
+        .set_meshes(&gpu.device, &gpu.queue, &[mesh])?;
+    Ok(renderer.render(&gpu.device, &gpu.queue, &camera, background, &[])?)
 }
 
 type Frames = (Vec<Vec<Vec3>>, Vec<[u32; 3]>);

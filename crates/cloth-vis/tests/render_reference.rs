@@ -4,17 +4,34 @@
 
 mod common;
 
-use cloth_vis::camera::Camera;
-use cloth_vis::render::{Backdrop, DrawMesh, render};
+use cloth_vis::camera::resolve;
 use cloth_vis::scene::CameraDesc;
 use glam::{Quat, Vec3, Vec4Swizzles};
-use gpu_context::{GpuContext, GpuOptions};
+use gpu_context::testing::gpu_or_skip as gpu;
+use gpu_context::{GpuContext, HdrImage};
+use render::{Backdrop, Background, Camera, DrawMesh, FrameFormat, Renderer};
 
-fn gpu() -> Option<GpuContext> {
-    match GpuContext::new(&GpuOptions::default()) {
-        Ok(g) => Some(g),
-        Err(e) => test_data::skip(&format!("no GPU adapter: {e}")),
-    }
+/// One single-sample frame of the shared renderer (pixel-exact against CPU references).
+fn render(
+    gpu: &GpuContext,
+    camera: &Camera,
+    meshes: &[DrawMesh<'_>],
+    backdrop: Option<Backdrop<'_>>,
+) -> HdrImage {
+    let mut renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
+    renderer
+        .gouraud
+        .set_meshes(&gpu.device, &gpu.queue, meshes)
+        .unwrap();
+    let background = if backdrop.is_some() {
+        Background::Environment
+    } else {
+        Background::Color([0.0; 3])
+    };
+    renderer.backdrop.set_environment(&gpu.device, backdrop);
+    renderer
+        .render(&gpu.device, &gpu.queue, camera, background, &[])
+        .unwrap()
 }
 
 /// A smooth synthetic environment with structure in both angles.
@@ -43,15 +60,15 @@ fn backdrop_matches_cpu_lookup_along_view_rays() {
         height: 40,
         ..CameraDesc::default()
     };
-    let camera = Camera::frame(&desc, Vec3::ZERO, 1.0);
+    let camera = resolve(&desc, Vec3::ZERO, 1.0);
     let backdrop = Backdrop {
         width: env.width(),
         height: env.height(),
         texels: env.texels(),
         world_from_env: rotation,
     };
-    let image = render(&gpu.device, &gpu.queue, &camera, &[], Some(backdrop)).unwrap();
-    let world_from_clip = camera.clip_from_world.inverse();
+    let image = render(&gpu, &camera, &[], Some(backdrop));
+    let world_from_clip = camera.clip_from_world().unwrap().inverse();
     let mut worst = 0.0f32;
     for y in 0..desc.height {
         for x in 0..desc.width {
@@ -80,7 +97,7 @@ fn a_triangle_covers_the_pixels_a_cpu_edge_test_predicts_with_two_sided_colours(
         height: 64,
         ..CameraDesc::default()
     };
-    let camera = Camera::frame(&desc, Vec3::ZERO, 1.0);
+    let camera = resolve(&desc, Vec3::ZERO, 1.0);
     let positions = [
         Vec3::new(-0.8, -0.6, 0.0),
         Vec3::new(0.7, -0.5, 0.0),
@@ -99,11 +116,11 @@ fn a_triangle_covers_the_pixels_a_cpu_edge_test_predicts_with_two_sided_colours(
             front: &front,
             back: &back,
         };
-        let image = render(&gpu.device, &gpu.queue, &camera, &[mesh], None).unwrap();
+        let image = render(&gpu, &camera, &[mesh], None);
         let screen: Vec<glam::Vec2> = positions
             .iter()
             .map(|p| {
-                let ndc = camera.clip_from_world.project_point3(*p);
+                let ndc = camera.clip_from_world().unwrap().project_point3(*p);
                 glam::Vec2::new((ndc.x + 1.0) * 32.0, (1.0 - ndc.y) * 32.0)
             })
             .collect();

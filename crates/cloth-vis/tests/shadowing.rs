@@ -5,7 +5,7 @@
 
 mod common;
 
-use cloth_vis::run::WorldObject;
+use cloth_vis::object::WorldObject;
 use cloth_vis::scene::Scene;
 use cloth_vis::shadowing::{light_objects, visibility};
 use glam::Vec3;
@@ -52,6 +52,7 @@ fn object(
         two_sided,
         front: None,
         back: None,
+        animation: None,
     }
 }
 

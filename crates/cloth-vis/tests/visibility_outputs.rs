@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use cloth_vis::camera::{Camera, bounding_sphere};
+use cloth_vis::camera::resolve;
 use cloth_vis::scene::CameraDesc;
 use cloth_vis::visibility_cmd::{
     GLB_UNUSED_AO, VisibilityRequest, env_rotation, light_radiance, run_visibility, vertex_radiance,
@@ -12,6 +12,7 @@ use cloth_vis::visibility_cmd::{
 use glam::Vec3;
 use gpu_context::{GpuContext, GpuOptions};
 use lightsphere::{Environment, Lightsphere, RadianceMethod};
+use render::bounding_sphere;
 
 /// An L-shaped fold: a floor (y = 0, facing +y) and a wall (x = 0, facing +x), 5×5 vertices
 /// each, sharing no vertex, so that a_i ranges from ~0.5 near the fold to ~1 far from it; plus
@@ -349,10 +350,13 @@ fn vertex_pixels(positions: &[Vec3], used: &[usize], size: [u32; 2]) -> Vec<(usi
         height: size[1],
         ..CameraDesc::default()
     };
-    let camera = Camera::frame(&desc, centre, radius);
+    let camera = resolve(&desc, centre, radius);
     used.iter()
         .map(|&i| {
-            let ndc = camera.clip_from_world.project_point3(positions[i]);
+            let ndc = camera
+                .clip_from_world()
+                .unwrap()
+                .project_point3(positions[i]);
             let x = ((ndc.x + 1.0) * 0.5 * size[0] as f32) as usize;
             let y = ((1.0 - ndc.y) * 0.5 * size[1] as f32) as usize;
             (x, y)

@@ -141,9 +141,15 @@ impl GpuContext {
                 .to_owned(),
             is_software: info.device_type == wgpu::DeviceType::Cpu,
         };
+        // Optional features the renderer uses when the adapter has them: MSAA on Rgba32Float
+        // (adapter-specific format features), a float depth with stencil, float32 blending.
+        let optional = (wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
+            | wgpu::Features::DEPTH32FLOAT_STENCIL8
+            | wgpu::Features::FLOAT32_BLENDABLE)
+            & adapter.features();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("cloth-vis device"),
-            required_features: options.required_features,
+            required_features: options.required_features | optional,
             required_limits: adapter.limits(),
             ..Default::default()
         }))

@@ -96,18 +96,7 @@ impl HdrImage {
     /// # Errors
     /// [`GpuError::Write`] naming the path.
     pub fn write_png(&self, path: &Path, tonemap: &Tonemap) -> Result<(), GpuError> {
-        let rgba = self.to_rgba8(tonemap);
-        atomic_write(path, |tmp| {
-            image::save_buffer_with_format(
-                tmp,
-                &rgba,
-                self.width,
-                self.height,
-                image::ColorType::Rgba8,
-                image::ImageFormat::Png,
-            )
-            .map_err(|e| e.to_string())
-        })
+        write_rgba8_png(path, &self.to_rgba8(tonemap), self.width, self.height)
     }
 
     /// Write a linear 32-bit float RGBA OpenEXR file. The file appears complete or not at all.
@@ -126,9 +115,31 @@ impl HdrImage {
     }
 }
 
-/// Run `write` on a temporary path beside `path`, then rename it into place; on failure the
-/// temporary file is removed and nothing is left at `path`.
-fn atomic_write(
+/// Write 8-bit RGBA pixels (row-major, top row first) as a PNG. The file appears complete or
+/// not at all.
+///
+/// # Errors
+/// [`GpuError::Write`] naming the path (also when `rgba` is not `4 · width · height` bytes).
+pub fn write_rgba8_png(path: &Path, rgba: &[u8], width: u32, height: u32) -> Result<(), GpuError> {
+    atomic_write(path, |tmp| {
+        image::save_buffer_with_format(
+            tmp,
+            rgba,
+            width,
+            height,
+            image::ColorType::Rgba8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| e.to_string())
+    })
+}
+
+/// Run `write` on a temporary path beside `path` (a hidden `.NAME.PID.tmp`), then rename it
+/// into place; on failure the temporary file is removed and nothing is left at `path`.
+///
+/// # Errors
+/// [`GpuError::Write`] naming `path` with `write`'s reason, or the rename's.
+pub fn atomic_write(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), GpuError> {

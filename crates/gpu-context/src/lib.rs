@@ -28,9 +28,13 @@
 mod adapter;
 mod error;
 mod image_out;
+pub mod layout;
 mod offscreen;
+pub mod pipeline;
+pub mod testing;
 
 pub use adapter::{ADAPTER_ENV, AdapterSummary, BACKEND_ENV, GpuContext, GpuOptions};
 pub use error::GpuError;
-pub use image_out::{HdrImage, Tonemap};
-pub use offscreen::{COLOR_FORMAT, DEPTH_FORMAT, OffscreenTarget, read_buffer};
+pub use image_out::{HdrImage, Tonemap, atomic_write, write_rgba8_png};
+pub use offscreen::{COLOR_FORMAT, DEPTH_FORMAT, OffscreenTarget, read_buffer, read_texture};
+pub use pipeline::{PipelineStats, RenderPipelineDesc};

@@ -134,8 +134,12 @@ impl OffscreenTarget {
     }
 }
 
-/// Copy a whole 2-D texture into tightly packed bytes (row padding removed).
-fn read_texture(
+/// Copy a whole 2-D texture (one aspect, `texel_bytes` per texel, `COPY_SRC` usage) into
+/// tightly packed bytes, row-major, top row first (row padding removed).
+///
+/// # Errors
+/// [`GpuError::Readback`] when mapping fails or the device is lost.
+pub fn read_texture(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     texture: &wgpu::Texture,

@@ -1,13 +1,9 @@
 //! Offscreen targets on whatever adapter exists (lavapipe in CI): clear, read back, compare.
 
-use gpu_context::{GpuContext, GpuOptions, OffscreenTarget};
+use gpu_context::OffscreenTarget;
 
-fn context() -> Option<GpuContext> {
-    match GpuContext::new(&GpuOptions::default()) {
-        Ok(ctx) => Some(ctx),
-        Err(e) => test_data::skip(&format!("no GPU adapter: {e}")),
-    }
-}
+/// The shared GPU-or-skip harness (fails under CI, visible skip otherwise).
+use gpu_context::testing::gpu_or_skip as context;
 
 #[test]
 fn cleared_target_reads_back_exact_hdr_values_and_depth() {

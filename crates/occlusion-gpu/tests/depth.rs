@@ -3,16 +3,12 @@
 mod common;
 
 use common::*;
-use gpu_context::{GpuContext, GpuOptions};
+use gpu_context::GpuContext;
 use lightsphere::Lightsphere;
 use occlusion_gpu::{Backend, DepthParams, Scene, VisibilityEngine, VisibilityParams};
 
-fn gpu() -> Option<GpuContext> {
-    match GpuContext::new(&GpuOptions::default()) {
-        Ok(ctx) => Some(ctx),
-        Err(e) => test_data::skip(&format!("no GPU adapter: {e}")),
-    }
-}
+/// The shared GPU-or-skip harness (fails under CI, visible skip otherwise).
+use gpu_context::testing::gpu_or_skip as gpu;
 
 fn depth_engine(ctx: &GpuContext, resolution: u32) -> VisibilityEngine {
     let params =

@@ -6,7 +6,6 @@ mod common;
 
 use common::*;
 use glam::Vec3;
-use gpu_context::{GpuContext, GpuOptions};
 use lightsphere::Lightsphere;
 use occlusion_gpu::{
     Backend, Camera, DepthParams, FilterParams, FilterThreshold, FilteredVisibility,
@@ -17,12 +16,8 @@ use occlusion_gpu::{
 
 const SIZE: u32 = 96;
 
-fn gpu() -> Option<GpuContext> {
-    match GpuContext::new(&GpuOptions::default()) {
-        Ok(ctx) => Some(ctx),
-        Err(e) => test_data::skip(&format!("no GPU adapter: {e}")),
-    }
-}
+/// The shared GPU-or-skip harness (fails under CI, visible skip otherwise).
+use gpu_context::testing::gpu_or_skip as gpu;
 
 fn cpu_engine() -> VisibilityEngine {
     VisibilityEngine::cpu(VisibilityParams::default())

@@ -7,19 +7,15 @@ mod common;
 use std::time::Instant;
 
 use common::*;
-use gpu_context::{GpuContext, GpuOptions};
+use gpu_context::GpuContext;
 use lightsphere::Lightsphere;
 use occlusion_gpu::{
     Backend, DepthParams, OcclusionError, Scene, VisibilityEngine, VisibilityMatrix,
     VisibilityParams,
 };
 
-fn gpu() -> Option<GpuContext> {
-    match GpuContext::new(&GpuOptions::default()) {
-        Ok(ctx) => Some(ctx),
-        Err(e) => test_data::skip(&format!("no GPU adapter: {e}")),
-    }
-}
+/// The shared GPU-or-skip harness (fails under CI, visible skip otherwise).
+use gpu_context::testing::gpu_or_skip as gpu;
 
 fn engine(ctx: &GpuContext, backend: Backend, resolution: u32) -> VisibilityEngine {
     let params =

@@ -46,16 +46,35 @@ pub fn shared_file(relative: &str) -> Option<PathBuf> {
     skip(&format!("shared data file {} not found", path.display()))
 }
 
+/// Skips so far in this test binary.
+static SKIPS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 /// Report that a test cannot run for `reason` (missing data or GPU adapter).
 ///
+/// The message goes to the process's stderr handle directly, not through `eprintln!`: libtest
+/// captures the macros' output of passing tests, so a skip printed with them never reaches the
+/// terminal and "N passed" would hide tests that did nothing.
+///
 /// # Panics
-/// When [`in_ci`] is true. Otherwise prints `SKIPPED: <caller>: <reason>` to stderr and returns `None`.
+/// When [`in_ci`] is true. Otherwise prints
+/// `SKIPPED (n in this binary): <caller>: <reason>` to stderr and returns `None`.
 #[track_caller]
 pub fn skip<T>(reason: &str) -> Option<T> {
+    use std::io::Write;
     let caller = std::panic::Location::caller();
     if in_ci() {
         panic!("{caller}: {reason} (CI is set, so this test must not be skipped)");
     }
-    eprintln!("SKIPPED: {caller}: {reason} (set CI=1 to make this a failure)");
+    let n = SKIPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+    // A failed write to stderr leaves nothing better to report to.
+    let _ = writeln!(
+        std::io::stderr().lock(),
+        "SKIPPED ({n} in this binary): {caller}: {reason} (set CI=1 to make this a failure)"
+    );
     None
+}
+
+/// How many tests of this binary have skipped so far.
+pub fn skipped_so_far() -> usize {
+    SKIPS.load(std::sync::atomic::Ordering::Relaxed)
 }

@@ -6,9 +6,11 @@
 // Non-indexed draw of 3 × triangles vertices: the vertex shader fetches the triangle's three
 // vertex ids from `triangles`, passes them flat to all three corners together with a
 // barycentric coordinate (1,0,0), (0,1,0), (0,0,1), interpolated perspective-correct.
+//
+// Drawn into the shared frame (crate `render`): `view.wgsl` is prepended and binds the camera
+// at group 0; this pass's data is group 1.
 
 struct Frame {
-    clip_from_world: mat4x4<f32>,
     // rgb: the light's radiance g.
     radiance: vec4<f32>,
     // xy: uv scale.
@@ -36,15 +38,15 @@ struct LayerInfo {
     _pad: u32,
 }
 
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> geometry: array<GeomVertex>;
-@group(0) @binding(2) var<storage, read> triangles: array<u32>;
+@group(1) @binding(0) var<uniform> frame: Frame;
+@group(1) @binding(1) var<storage, read> geometry: array<GeomVertex>;
+@group(1) @binding(2) var<storage, read> triangles: array<u32>;
 // Per vertex: slots j_0..j_3 (u32), ω_0..ω_3 (f32 bits), then 4 × γ stride γ values (f32 bits).
-@group(0) @binding(3) var<storage, read> records: array<u32>;
-@group(0) @binding(4) var<storage, read> layers: array<LayerInfo>;
+@group(1) @binding(3) var<storage, read> records: array<u32>;
+@group(1) @binding(4) var<storage, read> layers: array<LayerInfo>;
 // Per view slot: (first layer, c_j + 1).
-@group(0) @binding(5) var<storage, read> slots: array<vec2<u32>>;
-@group(0) @binding(6) var textures: texture_3d<u32>;
+@group(1) @binding(5) var<storage, read> slots: array<vec2<u32>>;
+@group(1) @binding(6) var textures: texture_3d<u32>;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -58,7 +60,7 @@ fn vs_main(@builtin(vertex_index) index: u32) -> VsOut {
     let corner = index % 3u;
     let ids = vec3<u32>(triangles[3u * t], triangles[3u * t + 1u], triangles[3u * t + 2u]);
     var out: VsOut;
-    out.clip = frame.clip_from_world * vec4<f32>(geometry[ids[corner]].position, 1.0);
+    out.clip = view.clip_from_world * vec4<f32>(geometry[ids[corner]].position, 1.0);
     var b = vec3<f32>(0.0);
     b[corner] = 1.0;
     out.bary = b;

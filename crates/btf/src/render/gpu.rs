@@ -11,8 +11,12 @@
 //!
 //! [`render_cpu`]: super::render_cpu
 
+use std::sync::Mutex;
+
+use ::render::{Background, FrameFormat, FramePass, PassContext, Phase, Renderer};
 use bytemuck::{Pod, Zeroable};
-use gpu_context::{COLOR_FORMAT, DEPTH_FORMAT, OffscreenTarget};
+use gpu_context::layout::{bind_group_layout, binding};
+use gpu_context::{RenderPipelineDesc, pipeline};
 use wgpu::util::DeviceExt;
 
 use super::image::RenderedImage;
@@ -30,7 +34,6 @@ const RECORD_HEADER: usize = 8;
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct FrameUniform {
-    clip_from_world: [[f32; 4]; 4],
     radiance: [f32; 4],
     uv_scale: [f32; 4],
     tex: [u32; 4],
@@ -88,6 +91,33 @@ pub struct GpuBtfRenderer {
     texture_view: wgpu::TextureView,
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
+    /// The single-sample frame of [`GpuBtfRenderer::render`]; `None` when built for a shared
+    /// frame ([`GpuBtfRenderer::for_frame`]).
+    standalone: Option<Mutex<Renderer>>,
+}
+
+/// One mesh prepared for a frame: the per-vertex records uploaded, ready to record into the
+/// shared frame ([`FramePass`], [`Phase::Opaque`]: it tests and writes depth like any opaque
+/// object, so BTF objects and Gouraud objects occlude each other).
+#[derive(Debug)]
+pub struct BtfDraw {
+    pipeline: wgpu::RenderPipeline,
+    bind_group: wgpu::BindGroup,
+    vertices: u32,
+}
+
+impl FramePass for BtfDraw {
+    fn phase(&self) -> Phase {
+        Phase::Opaque
+    }
+
+    fn record(&self, pass: &mut wgpu::RenderPass<'_>) {
+        if self.vertices > 0 {
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(1, &self.bind_group, &[]);
+            pass.draw(0..self.vertices, 0..1);
+        }
+    }
 }
 
 /// The smallest storage holding every texture's codes, and its texture format.
@@ -208,35 +238,34 @@ fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     }
 }
 
-fn layout_entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-        ty,
-        count: None,
-    }
-}
-
-fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    layout_entry(
-        binding,
-        wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-    )
-}
-
 impl GpuBtfRenderer {
     /// Uploads every texture of `pca` (means and eigen-normtextures of all 81 slots) and
-    /// builds the pipeline.
+    /// builds the pipeline for a single-sample frame of its own, for [`Self::render`] (what
+    /// the CPU reference is compared with, pixel for pixel).
     ///
     /// # Errors
     /// [`BtfError::GpuLimit`] naming the limit when the normtextures are wider or taller than
     /// `max_texture_dimension_3d`, or their Σ_j (c_j + 1) layers do not fit one 3-D texture
     /// even tiled.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, pca: &BtfPca) -> Result<Self> {
+        let renderer = Renderer::new(device, FrameFormat::single_sample(device));
+        let mut this = Self::for_frame(device, queue, pca, &renderer.pass_context())?;
+        this.standalone = Some(Mutex::new(renderer));
+        Ok(this)
+    }
+
+    /// Uploads `pca` as [`Self::new`] does, with the pipeline built for a shared frame
+    /// (`ctx` from [`Renderer::pass_context`]); draw with [`Self::prepare`] and hand the
+    /// [`BtfDraw`] to [`Renderer::render`].
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn for_frame(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        pca: &BtfPca,
+        ctx: &PassContext<'_>,
+    ) -> Result<Self> {
         let (w, h) = (pca.width, pca.height);
         let max_3d = device.limits().max_texture_dimension_3d;
         let layer_count: usize = pca.slots.iter().map(|s| s.textures.len()).sum();
@@ -303,7 +332,7 @@ impl GpuBtfRenderer {
         let layers = storage_init(device, "btf layers", bytemuck::cast_slice(&infos));
         let slots = storage_init(device, "btf slots", bytemuck::cast_slice(&slot_table));
         let texture_view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let (layout, pipeline) = make_pipeline(device);
+        let (layout, pipeline) = make_pipeline(device, ctx);
         Ok(Self {
             device: device.clone(),
             queue: queue.clone(),
@@ -316,18 +345,20 @@ impl GpuBtfRenderer {
             texture_view,
             layout,
             pipeline,
+            standalone: None,
         })
     }
 
-    /// Renders `mesh` under `light` seen by `camera` (blocking until the image is read back).
-    /// Same inputs, conventions and result as [`render_cpu`](super::render_cpu), to float
-    /// rounding and the GPU's rasterisation rules at triangle edges.
+    /// Renders `mesh` under `light` seen by `camera` in a single-sample frame of its own
+    /// (blocking until the image is read back). Same inputs, conventions and result as
+    /// [`render_cpu`](super::render_cpu), to float rounding and the GPU's rasterisation
+    /// rules at triangle edges.
     ///
     /// # Errors
     /// As [`render_cpu`](super::render_cpu) for invalid inputs; [`BtfError::GpuLimit`] when
     /// the image exceeds `max_texture_dimension_2d` or a per-frame buffer exceeds
     /// `max_storage_buffer_binding_size`; [`BtfError::GpuReadback`] when reading the image
-    /// back fails.
+    /// back fails or the renderer was built with [`Self::for_frame`].
     pub fn render(
         &self,
         mesh: &BtfMesh<'_>,
@@ -335,7 +366,42 @@ impl GpuBtfRenderer {
         camera: &Camera,
         params: &RenderParams,
     ) -> Result<RenderedImage> {
-        let clip_from_world = camera.clip_from_world()?;
+        let readback = |e: &dyn std::fmt::Display| BtfError::GpuReadback {
+            what: "GpuBtfRenderer::render",
+            reason: e.to_string(),
+        };
+        let standalone = self.standalone.as_ref().ok_or_else(|| {
+            readback(&"built for a shared frame: record its BtfDraw with render::Renderer")
+        })?;
+        let draw = self.prepare(mesh, light, camera, params)?;
+        let mut renderer = standalone.lock().map_err(|e| readback(&e))?;
+        let background = Background::Color(params.background.to_array());
+        let hdr = renderer
+            .render(&self.device, &self.queue, camera, background, &[&draw])
+            .map_err(|e| readback(&e))?;
+        let pixels = hdr.pixels().iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let coverage = hdr.pixels().iter().map(|p| p[3] > 0.5).collect();
+        Ok(RenderedImage::new(
+            camera.width,
+            camera.height,
+            pixels,
+            coverage,
+        ))
+    }
+
+    /// Computes the per-vertex slots, ω and γ of `mesh` for `camera`'s eye and `light`, and
+    /// uploads them: a [`BtfDraw`] to record into a frame built with the same format.
+    ///
+    /// # Errors
+    /// As [`Self::render`], without the read-back.
+    pub fn prepare(
+        &self,
+        mesh: &BtfMesh<'_>,
+        light: &Light,
+        camera: &Camera,
+        params: &RenderParams,
+    ) -> Result<BtfDraw> {
+        camera.validate()?;
         light.validate()?;
         params.validate()?;
         let frames = mesh.frames()?;
@@ -385,7 +451,6 @@ impl GpuBtfRenderer {
             })
             .collect();
         let uniform = FrameUniform {
-            clip_from_world: clip_from_world.to_cols_array_2d(),
             radiance: light.radiance().extend(0.0).to_array(),
             uv_scale: [params.uv_scale.x, params.uv_scale.y, 0.0, 0.0],
             tex: [
@@ -426,67 +491,12 @@ impl GpuBtfRenderer {
             ],
         });
 
-        let readback = |e: &dyn std::fmt::Display| BtfError::GpuReadback {
-            what: "GpuBtfRenderer::render",
-            reason: e.to_string(),
-        };
-        let target =
-            OffscreenTarget::new(device, camera.width, camera.height).map_err(|e| readback(&e))?;
-        let color_view = target.color_view();
-        let depth_view = target.depth_view();
-        let bg = params.background.as_dvec3();
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("btf render"),
-        });
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("btf render"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        // Alpha 0 marks pixels no triangle covers.
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: bg.x,
-                            g: bg.y,
-                            b: bg.z,
-                            a: 0.0,
-                        }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if !mesh.triangles.is_empty() {
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &bind_group, &[]);
-                // ≤ u32::MAX / 4 triangles: the triangle buffer was checked above.
-                pass.draw(0..3 * mesh.triangles.len() as u32, 0..1);
-            }
-        }
-        self.queue.submit([encoder.finish()]);
-        let hdr = target
-            .read_color(device, &self.queue)
-            .map_err(|e| readback(&e))?;
-        let pixels = hdr.pixels().iter().map(|p| [p[0], p[1], p[2]]).collect();
-        let coverage = hdr.pixels().iter().map(|p| p[3] > 0.5).collect();
-        Ok(RenderedImage::new(
-            camera.width,
-            camera.height,
-            pixels,
-            coverage,
-        ))
+        Ok(BtfDraw {
+            pipeline: self.pipeline.clone(),
+            bind_group,
+            // ≤ u32::MAX: the triangle buffer was checked above.
+            vertices: 3 * mesh.triangles.len() as u32,
+        })
     }
 }
 
@@ -521,78 +531,44 @@ fn weights_only(pca: &BtfPca) -> BtfPca {
     }
 }
 
-fn make_pipeline(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("btf_render.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(SHADER.into()),
-    });
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("btf render"),
-        entries: &[
-            layout_entry(
-                0,
-                wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-            ),
-            storage_entry(1),
-            storage_entry(2),
-            storage_entry(3),
-            storage_entry(4),
-            storage_entry(5),
-            layout_entry(
-                6,
-                wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Uint,
-                    view_dimension: wgpu::TextureViewDimension::D3,
-                    multisampled: false,
-                },
+fn make_pipeline(
+    device: &wgpu::Device,
+    ctx: &PassContext<'_>,
+) -> (wgpu::BindGroupLayout, wgpu::RenderPipeline) {
+    let source = format!("{}\n{}", ::render::VIEW_SHADER, SHADER);
+    let module = pipeline::shader_module(device, "btf_render.wgsl", &source);
+    let layout = bind_group_layout(
+        device,
+        "btf render",
+        wgpu::ShaderStages::VERTEX_FRAGMENT,
+        &[
+            binding::uniform(),
+            binding::storage_read(),
+            binding::storage_read(),
+            binding::storage_read(),
+            binding::storage_read(),
+            binding::storage_read(),
+            binding::texture(
+                wgpu::TextureSampleType::Uint,
+                wgpu::TextureViewDimension::D3,
             ),
         ],
-    });
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("btf render"),
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
-    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("btf render"),
-        layout: Some(&pipeline_layout),
-        vertex: wgpu::VertexState {
-            module: &module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            front_face: wgpu::FrontFace::Ccw,
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: Some(wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: wgpu::StencilState::default(),
-            bias: wgpu::DepthBiasState::default(),
-        }),
-        multisample: wgpu::MultisampleState::default(),
-        fragment: Some(wgpu::FragmentState {
-            module: &module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format: COLOR_FORMAT,
-                blend: None,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
-        }),
-        multiview_mask: None,
-        cache: None,
-    });
+    );
+    let pipeline_layout =
+        pipeline::pipeline_layout(device, "btf render", &[ctx.view_layout, &layout]);
+    let pipeline = RenderPipelineDesc {
+        label: "btf render",
+        layout: &pipeline_layout,
+        module: &module,
+        vertex: "vs_main",
+        fragment: Some("fs_main"),
+        buffers: &[],
+        color: Some(ctx.format.color_target()),
+        depth_stencil: Some(ctx.format.opaque_depth()),
+        samples: ctx.format.samples,
+        cull_mode: None,
+    }
+    .build(device);
     (layout, pipeline)
 }
 

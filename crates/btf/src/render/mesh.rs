@@ -1,6 +1,6 @@
 //! The inputs of a rendering: mesh, light, camera and parameters, and their validation.
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 
 use crate::error::{BtfError, Result};
 
@@ -251,120 +251,9 @@ impl Light {
     }
 }
 
-/// A perspective pinhole camera and the image size, shared by the CPU and GPU paths.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    /// World-space eye position.
-    pub eye: Vec3,
-    /// World-space point looked at (the image centre).
-    pub target: Vec3,
-    /// World-space up direction (the image's up, after orthogonalisation).
-    pub up: Vec3,
-    /// Vertical field of view in degrees, in (0, 180).
-    pub fov_y_deg: f32,
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels.
-    pub height: u32,
-    /// Distance of the near clipping plane (> 0).
-    pub near: f32,
-    /// Distance of the far clipping plane (> near).
-    pub far: f32,
-}
-
-/// [`Camera::look_at`]'s near plane as a fraction of the eye–target distance.
-const NEAR_FRACTION: f32 = 1e-2;
-/// [`Camera::look_at`]'s far plane as a multiple of the eye–target distance.
-const FAR_MULTIPLE: f32 = 1e2;
-
-impl Camera {
-    /// A camera at `eye` looking at `target`, with clipping planes at 1/100 and 100 times the
-    /// eye–target distance (set `near`/`far` to change them).
-    pub fn look_at(
-        eye: Vec3,
-        target: Vec3,
-        up: Vec3,
-        fov_y_deg: f32,
-        width: u32,
-        height: u32,
-    ) -> Self {
-        let distance = eye.distance(target);
-        Self {
-            eye,
-            target,
-            up,
-            fov_y_deg,
-            width,
-            height,
-            near: NEAR_FRACTION * distance,
-            far: FAR_MULTIPLE * distance,
-        }
-    }
-
-    /// `perspective(fov_y, width/height, near, far) · look_at(eye, target, up)` (glam's
-    /// right-handed camera with DirectX-style depth): world to wgpu clip space (x, y ∈ [−w, w] left to right and bottom to top, depth z ∈ [0, w]).
-    ///
-    /// # Errors
-    /// [`BtfError::InvalidParameter`] for an empty image, a field of view outside (0°, 180°),
-    /// non-finite vectors, eye = target, `up` parallel to the view direction, or clipping
-    /// planes not 0 < near < far.
-    pub fn clip_from_world(&self) -> Result<Mat4> {
-        let bad = |name, value: String, reason| {
-            Err(BtfError::InvalidParameter {
-                what: "Camera",
-                name,
-                value,
-                reason,
-            })
-        };
-        if self.width == 0 || self.height == 0 {
-            let size = format!("{} × {}", self.width, self.height);
-            return bad("width × height", size, "the image must not be empty");
-        }
-        if !(self.fov_y_deg > 0.0 && self.fov_y_deg < 180.0) {
-            let fov = self.fov_y_deg.to_string();
-            return bad("fov_y_deg", fov, "the field of view must be in (0°, 180°)");
-        }
-        for (name, v) in [("eye", self.eye), ("target", self.target), ("up", self.up)] {
-            if !v.is_finite() {
-                return bad(name, v.to_string(), "must be finite");
-            }
-        }
-        let forward = self.target - self.eye;
-        if forward.length_squared() == 0.0 {
-            return bad(
-                "target",
-                self.target.to_string(),
-                "must differ from the eye",
-            );
-        }
-        if forward.cross(self.up).length_squared() <= f32::EPSILON * forward.length_squared() {
-            return bad(
-                "up",
-                self.up.to_string(),
-                "must be non-zero and not parallel to the view direction",
-            );
-        }
-        if !(self.near > 0.0 && self.far > self.near && self.far.is_finite()) {
-            let planes = format!("near {} far {}", self.near, self.far);
-            return bad(
-                "near, far",
-                planes,
-                "clipping planes need 0 < near < far < ∞",
-            );
-        }
-        let aspect = self.width as f32 / self.height as f32;
-        // wgpu clip space: y up, depth 0..1 (the DirectX convention), as in `cloth-vis`.
-        let clip_from_view = glam::camera::rh::proj::directx::perspective(
-            self.fov_y_deg.to_radians(),
-            aspect,
-            self.near,
-            self.far,
-        );
-        let view_from_world = glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up);
-        Ok(clip_from_view * view_from_world)
-    }
-}
+/// The workspace's one camera (crate `render`): a perspective pinhole and the image size,
+/// shared by the CPU and GPU paths and by every other pass of the frame.
+pub use ::render::Camera;
 
 /// Knobs of a rendering.
 #[derive(Clone, Copy, Debug, PartialEq)]

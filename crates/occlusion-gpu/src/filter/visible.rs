@@ -23,7 +23,7 @@ use wgpu::util::DeviceExt;
 use crate::scene::Prepared;
 use crate::{OcclusionError, Scene};
 
-const ID_SHADER: &str = include_str!("../../../../shaders/triangle_ids.wgsl");
+const ID_SHADER: &str = include_str!("triangle_ids.wgsl");
 /// Near plane of [`Camera::look_at`] as a fraction of the eye–target distance.
 const LOOK_AT_NEAR_RELATIVE: f32 = 1e-3;
 

@@ -53,8 +53,8 @@ const WORKGROUP_SIZE: u32 = 64;
 /// Largest workgroup count per dispatch dimension guaranteed by WebGPU.
 const MAX_GROUPS_PER_DIMENSION: u32 = 65_535;
 
-const DEPTH_SHADER: &str = include_str!("../../../../shaders/occlusion_depth.wgsl");
-const TEST_SHADER: &str = include_str!("../../../../shaders/occlusion_test.wgsl");
+const DEPTH_SHADER: &str = include_str!("occlusion_depth.wgsl");
+const TEST_SHADER: &str = include_str!("occlusion_test.wgsl");
 
 /// Tuning knobs of the `depth` backend. The `query` backend uses the same resolution, bias
 /// and normal offset (so both GPU backends decide alike); it ignores `max_array_bytes` (one

@@ -34,8 +34,8 @@ use crate::scene::Prepared;
 /// keep per-submission overhead small on lavapipe, small enough to keep the buffer modest.
 const DEFAULT_MAX_BATCH_QUERIES: usize = 64 * QUERY_SET_MAX_QUERIES as usize;
 
-const QUERY_SHADER: &str = include_str!("../../../../shaders/occlusion_query.wgsl");
-const PACK_SHADER: &str = include_str!("../../../../shaders/occlusion_pack.wgsl");
+const QUERY_SHADER: &str = include_str!("occlusion_query.wgsl");
+const PACK_SHADER: &str = include_str!("occlusion_pack.wgsl");
 
 /// `struct Params` of `occlusion_query.wgsl`.
 #[repr(C)]

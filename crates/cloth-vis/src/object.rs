@@ -1,0 +1,88 @@
+//! One object of a scene in world space: geometry, material, its animation when it has one,
+//! and its lighting once computed. Shared by the stages (`run`, `shadowing`, `btf_stage`).
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec2, Vec3};
+
+/// One object in world space, with its lighting once computed.
+#[derive(Clone, Debug)]
+pub struct WorldObject {
+    /// Object name.
+    pub name: String,
+    /// World-space positions of the current frame.
+    pub positions: Vec<Vec3>,
+    /// World-space unit normals (zero for unreferenced vertices).
+    pub normals: Vec<Vec3>,
+    /// Triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// Texture coordinates, one per position, when the source has them (the synthetic cloth
+    /// and meshes with per-vertex UVs); the `btf` effect needs them.
+    pub uvs: Option<Vec<Vec2>>,
+    /// Albedo ρ.
+    pub albedo: Vec3,
+    /// Lit on both sides.
+    pub two_sided: bool,
+    /// Radiance towards the front side, once the lighting stage ran.
+    pub front: Option<Vec<Vec3>>,
+    /// Radiance towards the back side, once the lighting stage ran.
+    pub back: Option<Vec<Vec3>>,
+    /// The object-space frames of an animated source, and the transform to world space.
+    pub animation: Option<Animation>,
+}
+
+/// The frames of an animated object, in object space.
+#[derive(Clone, Debug)]
+pub struct Animation {
+    /// Positions per frame.
+    pub frames: Arc<Vec<Vec<Vec3>>>,
+    /// `world_from_object` of the object.
+    pub world_from_object: Mat4,
+}
+
+impl WorldObject {
+    /// Number of animation frames (1 for a static object).
+    pub fn frame_count(&self) -> usize {
+        self.animation.as_ref().map_or(1, |a| a.frames.len())
+    }
+
+    /// Pose an animated object at `frame` (world positions and normals; lighting cleared).
+    /// Static objects are left as they are. Returns whether anything moved.
+    pub fn pose(&mut self, frame: usize) -> bool {
+        let Some(anim) = &self.animation else {
+            return false;
+        };
+        let Some(source) = anim.frames.get(frame) else {
+            return false;
+        };
+        self.positions.clear();
+        self.positions.extend(
+            source
+                .iter()
+                .map(|p| anim.world_from_object.transform_point3(*p)),
+        );
+        // In world space from the transformed positions, so any transform (including
+        // mirroring scales) keeps normals consistent with the winding.
+        self.normals = meshio::compute_normals(
+            &self.positions,
+            &self.triangles,
+            meshio::NormalWeighting::Angle,
+        );
+        self.front = None;
+        self.back = None;
+        true
+    }
+
+    /// The world positions of every frame (for framing a camera over a whole sequence).
+    pub fn all_world_positions(&self) -> Vec<Vec3> {
+        match &self.animation {
+            None => self.positions.clone(),
+            Some(anim) => anim
+                .frames
+                .iter()
+                .flatten()
+                .map(|p| anim.world_from_object.transform_point3(*p))
+                .collect(),
+        }
+    }
+}
