@@ -583,7 +583,12 @@ fn load_environment(scene: &Scene) -> Result<(lightsphere::Environment, serde_js
             lightsphere::Environment::load(&path)?,
             path.display().to_string(),
         ),
-        None => unreachable!("checked above"),
+        None => {
+            return Err(Error::Scene {
+                origin: scene.origin.clone(),
+                message: "environment stage planned without an environment source".to_owned(),
+            });
+        }
     };
     let rotation = Quat::from_rotation_y(desc.rotation_deg.to_radians());
     let mut env = env.with_rotation(rotation);

@@ -182,7 +182,14 @@ fn typos_and_bad_values_are_reported_with_location() {
         ("[lighting]\nlevel = 9\n", "lighting.level"),
         ("[camera]\nwidth = 0\n", "camera.width"),
         ("[camera]\nfov_deg = 180.0\n", "camera.fov_deg"),
-        ("[output]\nexposure = -1.0\n", "output.exposure"),
+        ("[output]\nexposure = 100.0\n", "output.exposure"),
+        (
+            "[output]\nbackground = [0.0, -1.0, 0.0]\n",
+            "output.background",
+        ),
+        ("[output]\nframes = \"3..1\"\n", "output.frames"),
+        ("[ground]\ncells = 0\n", "ground.cells"),
+        ("[ground]\nsize = -2.0\n", "ground.size"),
         ("[output]\npng = \"../escape.png\"\n", "output.png"),
         ("[synth]\ncloth_grid = 1\n", "synth.cloth_grid"),
     ] {

@@ -7,10 +7,13 @@ struct MeshIn {
     @location(2) back: vec3<f32>,
 };
 
+// Centroid sampling: under MSAA a fragment of a partly covered pixel is shaded inside its
+// triangle, not at the pixel centre, where interpolation would extrapolate (and a steep
+// radiance gradient at a silhouette goes negative).
 struct MeshOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) front: vec3<f32>,
-    @location(1) back: vec3<f32>,
+    @location(0) @interpolate(perspective, centroid) front: vec3<f32>,
+    @location(1) @interpolate(perspective, centroid) back: vec3<f32>,
 };
 
 @vertex

@@ -133,8 +133,8 @@ fn alpha_matte_equals_the_cpu_sample_coverage() {
         if (a - e).abs() > 1e-6 {
             differing += 1;
         }
-        // Premultiplied colour: rgb = coverage · colour.
-        assert!((p[0] - 0.3 * a).abs() < 1e-4, "pixel {i}: {p:?}");
+        // Premultiplied colour: rgb = coverage · colour (resolve in f32, centroid shading).
+        assert!((p[0] - 0.3 * a).abs() < 1e-3, "pixel {i}: {p:?}");
     }
     // Samples exactly on an edge are the only place a CPU test and the rasteriser's fill rule
     // may differ; generic geometry puts almost none there.

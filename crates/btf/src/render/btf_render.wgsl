@@ -50,7 +50,8 @@ struct LayerInfo {
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
-    @location(0) bary: vec3<f32>,
+    // Centroid: under MSAA, shade inside the triangle (no extrapolated barycentrics).
+    @location(0) @interpolate(perspective, centroid) bary: vec3<f32>,
     @location(1) @interpolate(flat) ids: vec3<u32>,
 }
 
