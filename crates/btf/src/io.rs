@@ -50,14 +50,10 @@ pub fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
-/// Linear value to sRGB-encoded, clamped to [0, 1].
+/// Linear value to sRGB-encoded, clamped to [0, 1] (the workspace's one sRGB encoder,
+/// [`render::tone::srgb_encode`]).
 pub fn linear_to_srgb(l: f32) -> f32 {
-    let l = if l.is_nan() { 0.0 } else { l.clamp(0.0, 1.0) };
-    if l <= 0.003_130_8 {
-        l * 12.92
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    }
+    ::render::tone::srgb_encode(l)
 }
 
 /// Linear value to an 8-bit sRGB code (clamped, rounded).

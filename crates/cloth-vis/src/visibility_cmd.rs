@@ -44,7 +44,7 @@ use crate::Error;
 use crate::scene::CameraDesc;
 
 /// Where automatic exposure puts the 90th percentile of the used vertices' luminance.
-const AUTO_EXPOSURE_KEY: f32 = 0.8;
+const AUTO_EXPOSURE_KEY: f32 = render::tone::AUTO_EXPOSURE_KEY;
 /// Default display gamma of `--render` PNGs and of `.ply` colours.
 pub const DEFAULT_GAMMA: f32 = 2.2;
 /// Default `--render` image size (width, height).
@@ -533,36 +533,29 @@ fn load_frames(input: &Path) -> Result<Frames, Error> {
 /// The exposure multiplier that maps the 90th percentile of the luminance of `c` over used
 /// vertices (non-zero normal) to [`AUTO_EXPOSURE_KEY`]; 1 when no vertex is lit.
 fn auto_exposure(c: &[Vec3], normals: &[Vec3]) -> f32 {
-    let mut lum: Vec<f32> = c
+    let lum = c
         .iter()
         .zip(normals)
         .filter(|(_, n)| **n != Vec3::ZERO)
-        .map(|(v, _)| v.dot(Vec3::new(0.2126, 0.7152, 0.0722)))
-        .filter(|l| l.is_finite() && *l > 0.0)
-        .collect();
-    if lum.is_empty() {
-        return 1.0;
-    }
-    let k = (lum.len() - 1) * 9 / 10;
-    let (_, key, _) = lum.select_nth_unstable_by(k, f32::total_cmp);
-    AUTO_EXPOSURE_KEY / *key
+        .map(|(v, _)| render::tone::luminance(v.to_array()));
+    render::tone::auto_exposure_ev(
+        lum,
+        render::tone::AUTO_EXPOSURE_PERCENTILE,
+        AUTO_EXPOSURE_KEY,
+    )
+    .map_or(1.0, f32::exp2)
 }
 
 /// Linear display colours: radiance scaled so that the 90th percentile of luminance is 0.8,
 /// clamped to [0, 1]; black for non-finite radiance (unused vertices).
 fn linear_display_colours(c: &[Vec3]) -> Vec<Vec3> {
-    let mut lum: Vec<f32> = c
-        .iter()
-        .map(|v| v.dot(Vec3::new(0.2126, 0.7152, 0.0722)))
-        .filter(|l| l.is_finite() && *l > 0.0)
-        .collect();
-    let scale = if lum.is_empty() {
-        1.0
-    } else {
-        let k = (lum.len() - 1) * 9 / 10;
-        let (_, key, _) = lum.select_nth_unstable_by(k, f32::total_cmp);
-        AUTO_EXPOSURE_KEY / *key
-    };
+    let lum = c.iter().map(|v| render::tone::luminance(v.to_array()));
+    let scale = render::tone::auto_exposure_ev(
+        lum,
+        render::tone::AUTO_EXPOSURE_PERCENTILE,
+        AUTO_EXPOSURE_KEY,
+    )
+    .map_or(1.0, f32::exp2);
     c.iter()
         .map(|v| {
             if v.is_finite() {

@@ -1,36 +1,9 @@
-//! Linear HDR images: tone mapping for display (exposure, gamma) and atomic PNG/EXR output.
+//! Linear HDR images and atomic PNG/EXR output. Tone mapping for display lives in one place,
+//! `render::tone` and `render::output`.
 
 use std::path::{Path, PathBuf};
 
 use crate::GpuError;
-
-/// Display mapping: `display = clamp(exposure · linear)^(1/gamma)`, the seed's "standard gamma
-/// correction" (paper 000 §5) with an exposure multiplier in front.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Tonemap {
-    /// Multiplier applied to linear radiance before clamping (1 = none).
-    pub exposure: f32,
-    /// Display gamma (2.2 by default; 1 = linear).
-    pub gamma: f32,
-}
-
-impl Default for Tonemap {
-    fn default() -> Self {
-        Self {
-            exposure: 1.0,
-            gamma: 2.2,
-        }
-    }
-}
-
-impl Tonemap {
-    /// Map one linear value to an 8-bit display value.
-    pub fn apply(&self, linear: f32) -> u8 {
-        let v = (linear * self.exposure).clamp(0.0, 1.0);
-        let v = if v.is_nan() { 0.0 } else { v };
-        (v.powf(1.0 / self.gamma) * 255.0 + 0.5) as u8
-    }
-}
 
 /// A linear RGBA image, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
@@ -75,28 +48,6 @@ impl HdrImage {
     /// Pixels, row-major, top row first.
     pub fn pixels(&self) -> &[[f32; 4]] {
         &self.pixels
-    }
-
-    /// 8-bit RGBA for display (alpha clamped, not gamma-mapped).
-    pub fn to_rgba8(&self, tonemap: &Tonemap) -> Vec<u8> {
-        let mut out = Vec::with_capacity(self.pixels.len() * 4);
-        for p in &self.pixels {
-            out.extend_from_slice(&[
-                tonemap.apply(p[0]),
-                tonemap.apply(p[1]),
-                tonemap.apply(p[2]),
-                (p[3].clamp(0.0, 1.0) * 255.0 + 0.5) as u8,
-            ]);
-        }
-        out
-    }
-
-    /// Write a tone-mapped 8-bit PNG. The file appears complete or not at all.
-    ///
-    /// # Errors
-    /// [`GpuError::Write`] naming the path.
-    pub fn write_png(&self, path: &Path, tonemap: &Tonemap) -> Result<(), GpuError> {
-        write_rgba8_png(path, &self.to_rgba8(tonemap), self.width, self.height)
     }
 
     /// Write a linear 32-bit float RGBA OpenEXR file. The file appears complete or not at all.
@@ -168,20 +119,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn tonemap_is_monotone_clamped_and_maps_one_to_white() {
-        let t = Tonemap::default();
-        assert_eq!(t.apply(0.0), 0);
-        assert_eq!(t.apply(1.0), 255);
-        assert_eq!(t.apply(1e9), 255);
-        assert_eq!(t.apply(f32::NAN), 0);
-        assert_eq!(t.apply(-1.0), 0);
-        // 0.5^(1/2.2) = 0.7297 -> 186
-        assert_eq!(t.apply(0.5), 186);
-        let brighter = Tonemap { exposure: 2.0, ..t };
-        assert_eq!(brighter.apply(0.5), 255);
-    }
-
-    #[test]
     fn image_size_is_checked() {
         assert!(matches!(
             HdrImage::new(2, 2, vec![[0.0; 4]; 3]),
@@ -212,7 +149,7 @@ mod tests {
         assert_eq!(read.layer_data.channel_data.pixels, img.pixels);
         // A directory that does not exist: error names the path, no file left behind.
         let bad = dir.join("missing-dir").join("y.png");
-        let err = img.write_png(&bad, &Tonemap::default()).unwrap_err();
+        let err = write_rgba8_png(&bad, &[0; 24], 3, 2).unwrap_err();
         assert!(err.to_string().contains("y.png"), "{err}");
         assert!(!bad.exists());
         std::fs::remove_dir_all(&dir).unwrap();

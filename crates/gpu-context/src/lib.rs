@@ -1,8 +1,14 @@
-//! GPU context for cloth-vis: one small helper that picks a wgpu adapter on any machine, and
-//! headless offscreen targets read back to linear HDR images saved as PNG or EXR.
+//! GPU context for cloth-vis: one small helper that picks a wgpu adapter on any machine,
+//! read-back of buffers and textures, linear HDR images written atomically as PNG or EXR, and
+//! the boilerplate every GPU crate shares: one-line bind-group layouts ([`layout`]), pipeline
+//! builders that count what they build ([`pipeline`]), and the GPU-or-skip test harness
+//! ([`testing`]).
 //!
 //! Every GPU entry point elsewhere in the workspace takes `&wgpu::Device` and `&wgpu::Queue`;
-//! acquiring them is this crate's only job. Adapter choice, in order:
+//! acquiring them is this crate's only job. The device is created with the adapter's own limits
+//! and, when offered, `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES` (MSAA on `Rgba32Float`),
+//! `DEPTH32FLOAT_STENCIL8` and `FLOAT32_BLENDABLE`, which the shared frame (crate `render`)
+//! uses. Adapter choice, in order:
 //!
 //! 1. the environment: `CLOTH_VIS_BACKEND` (or wgpu's own `WGPU_BACKEND`), a comma list of
 //!    `vulkan`, `gl`, `metal`, `dx12`, restricts the backends; `CLOTH_VIS_ADAPTER` (or
@@ -35,6 +41,6 @@ pub mod testing;
 
 pub use adapter::{ADAPTER_ENV, AdapterSummary, BACKEND_ENV, GpuContext, GpuOptions};
 pub use error::GpuError;
-pub use image_out::{HdrImage, Tonemap, atomic_write, write_rgba8_png};
+pub use image_out::{HdrImage, atomic_write, write_rgba8_png};
 pub use offscreen::{COLOR_FORMAT, DEPTH_FORMAT, OffscreenTarget, read_buffer, read_texture};
 pub use pipeline::{PipelineStats, RenderPipelineDesc};

@@ -66,11 +66,12 @@ pub fn skip<T>(reason: &str) -> Option<T> {
         panic!("{caller}: {reason} (CI is set, so this test must not be skipped)");
     }
     let n = SKIPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-    // A failed write to stderr leaves nothing better to report to.
-    let _ = writeln!(
-        std::io::stderr().lock(),
-        "SKIPPED ({n} in this binary): {caller}: {reason} (set CI=1 to make this a failure)"
+    // One write of the whole line, so it does not interleave with libtest's own lines; a
+    // failed write to stderr leaves nothing better to report to.
+    let line = format!(
+        "SKIPPED ({n} in this binary): {caller}: {reason} (set CI=1 to make this a failure)\n"
     );
+    let _ = std::io::stderr().lock().write_all(line.as_bytes());
     None
 }
 
