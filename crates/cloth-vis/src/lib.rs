@@ -1,14 +1,15 @@
 //! # cloth-vis
 //!
 //! The facade of the cloth-vis workspace: scene files, the effect graph that builds only the
-//! stages a scene asks for, file input through `meshio`, the wgpu renderer, the CLI
-//! (`cloth-vis render SCENE.toml --out DIR`, `cloth-vis demo --out DIR`, `cloth-vis inspect`)
-//! and the demo.
+//! stages a scene asks for, file input through `meshio`, the CLI
+//! (`cloth-vis render SCENE.toml --out DIR [--frames A..B]`, `cloth-vis demo --out DIR`,
+//! `cloth-vis inspect`, …) and the demo. It draws through the shared frame of crate `render`
+//! (one renderer per run, reused for every frame of a sequence) and holds no renderer itself.
 //!
-//! It implements the rendering side of paper 000 (thesis §4.4): per-vertex colours
-//! c_i = Σ_j M_ij I_j from a lightsphere of directions l_j with environment radiance I_j
-//! (§3.3, §3.4, §5), Gouraud-interpolated, with exposure and gamma for display. Until the
-//! occlusion-gpu crate lands, M_ij = max(0, n_i·l_j) (no visibility); see [`lighting`].
+//! It implements the lighting side of paper 000 (thesis §4.4): per-vertex colours
+//! c_i = ρ/π Σ_j M_ij I_j ω_j from a lightsphere of directions l_j with environment radiance
+//! I_j (§3.3, §3.4, §5), with M from occlusion-gpu for `self-shadowing` and
+//! M_ij = max(0, n_i·l_j) for plain `lighting` (see [`lighting`] and [`shadowing`]).
 //!
 //! Domain crates never depend on this one; it only ties them together.
 //!

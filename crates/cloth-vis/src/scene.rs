@@ -322,12 +322,38 @@ pub enum AutoKeyword {
 /// `"black"`, `"transparent"` (PNG and EXR carry the objects' coverage as alpha), or a linear
 /// colour `[r, g, b]`.
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, serde::Serialize)]
-#[serde(untagged)]
+#[serde(untagged, try_from = "BackgroundText")]
 pub enum BackgroundDesc {
     /// A keyword.
     Named(BackgroundKeyword),
     /// A constant linear colour.
     Color([f32; 3]),
+}
+
+/// What a scene file may write for `background`, before the keyword is checked (so that a
+/// misspelt keyword gets a message listing the choices, not serde's "no variant matched").
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum BackgroundText {
+    Text(String),
+    Color([f32; 3]),
+}
+
+impl TryFrom<BackgroundText> for BackgroundDesc {
+    type Error = String;
+    fn try_from(raw: BackgroundText) -> Result<Self, String> {
+        match raw {
+            BackgroundText::Color(c) => Ok(Self::Color(c)),
+            BackgroundText::Text(t) => match t.as_str() {
+                "environment" => Ok(Self::ENVIRONMENT),
+                "black" => Ok(Self::BLACK),
+                "transparent" => Ok(Self::TRANSPARENT),
+                other => Err(format!(
+                    "background {other:?} is not one of \"environment\", \"black\",                      \"transparent\" or a linear colour [r, g, b]"
+                )),
+            },
+        }
+    }
 }
 
 impl Default for BackgroundDesc {

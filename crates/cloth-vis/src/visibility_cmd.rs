@@ -24,7 +24,7 @@
 //!   glTF wants unit normals), `COLOR_0` as float linear RGB (the display colour before gamma:
 //!   glTF viewers apply the display encoding), and the float attribute `_AO` = a_i, with
 //!   **−1 for unused vertices** because glTF forbids NaN in accessor data;
-//! - `--render FILE.png|FILE.exr`: the last frame drawn by [`crate::render`] (Gouraud, both
+//! - `--render FILE.png|FILE.exr`: the last frame drawn by the shared frame of crate `render` (Gouraud, both
 //!   sides with c_i, the environment as backdrop when one is given) from an automatically
 //!   framed camera; PNG tone-mapped with `2^EV` exposure (default: the 90th percentile of the
 //!   used vertices' luminance maps to 0.8) and gamma, EXR linear. Needs a GPU adapter

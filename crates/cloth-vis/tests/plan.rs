@@ -178,6 +178,17 @@ fn typos_and_bad_values_are_reported_with_location() {
     .unwrap_err()
     .to_string();
     assert!(err.contains("typo.toml") && err.contains("sourse"), "{err}");
+    let err = cloth_vis::Scene::from_toml(
+        "[[object]]\nname = \"a\"\nsource = \"synth:cloth\"\n[output]\nbackground = \"pink\"\n",
+        ".".as_ref(),
+        "pink.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("pink.toml") && err.contains("\"pink\"") && err.contains("transparent"),
+        "{err}"
+    );
     for (extra, key) in [
         ("[lighting]\nlevel = 9\n", "lighting.level"),
         ("[camera]\nwidth = 0\n", "camera.width"),

@@ -100,7 +100,7 @@ mod tangent;
 
 pub use cpu::render_cpu;
 #[cfg(feature = "gpu")]
-pub use gpu::GpuBtfRenderer;
+pub use gpu::{BtfDraw, GpuBtfRenderer};
 pub use image::RenderedImage;
 pub use mesh::{BtfMesh, Camera, Light, RenderParams};
 pub use tangent::tangent_frames;
