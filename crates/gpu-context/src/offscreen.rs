@@ -98,20 +98,7 @@ impl OffscreenTarget {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
     ) -> Result<HdrImage, GpuError> {
-        const TEXEL_BYTES: u32 = 16;
-        let bytes = read_texture(
-            device,
-            queue,
-            &self.color,
-            TEXEL_BYTES,
-            wgpu::TextureAspect::All,
-        )?;
-        let floats: &[f32] = bytemuck::cast_slice(&bytes);
-        let pixels = floats
-            .chunks_exact(4)
-            .map(|p| [p[0], p[1], p[2], p[3]])
-            .collect();
-        HdrImage::new(self.width, self.height, pixels)
+        read_hdr_image(device, queue, &self.color)
     }
 
     /// Copy the depth texture to the CPU (blocking), row-major, top row first.
@@ -132,6 +119,32 @@ impl OffscreenTarget {
         )?;
         Ok(bytemuck::cast_slice(&bytes).to_vec())
     }
+}
+
+/// Copy a whole `Rgba32Float` texture (`COPY_SRC` usage) to the CPU as a linear HDR image,
+/// top row first.
+///
+/// # Errors
+/// [`GpuError::Readback`] when mapping fails or the device is lost.
+pub fn read_hdr_image(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+) -> Result<HdrImage, GpuError> {
+    const TEXEL_BYTES: u32 = 16;
+    let bytes = read_texture(
+        device,
+        queue,
+        texture,
+        TEXEL_BYTES,
+        wgpu::TextureAspect::All,
+    )?;
+    let floats: &[f32] = bytemuck::cast_slice(&bytes);
+    let pixels = floats
+        .chunks_exact(4)
+        .map(|p| [p[0], p[1], p[2], p[3]])
+        .collect();
+    HdrImage::new(texture.width(), texture.height(), pixels)
 }
 
 /// Copy a whole 2-D texture (one aspect, `texel_bytes` per texel, `COPY_SRC` usage) into

@@ -9,7 +9,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use gpu_context::layout::{bind_group, bind_group_layout, binding};
-use gpu_context::{GpuError, HdrImage, read_texture};
+use gpu_context::{GpuError, HdrImage, read_hdr_image};
 use wgpu::util::DeviceExt;
 
 use crate::RenderError;
@@ -237,20 +237,8 @@ impl Renderer {
             }
         }
         queue.submit([encoder.finish()]);
-        const TEXEL_BYTES: u32 = 16;
-        let bytes = read_texture(
-            device,
-            queue,
-            &target.resolved,
-            TEXEL_BYTES,
-            wgpu::TextureAspect::All,
-        )?;
-        let floats: &[f32] = bytemuck::cast_slice(&bytes);
-        let pixels = floats
-            .chunks_exact(4)
-            .map(|p| [p[0], p[1], p[2], p[3]])
-            .collect();
+        let image = read_hdr_image(device, queue, &target.resolved)?;
         self.frames += 1;
-        Ok(HdrImage::new(camera.width, camera.height, pixels)?)
+        Ok(image)
     }
 }
