@@ -42,6 +42,7 @@ pub mod camera;
 pub mod demo;
 pub mod effects;
 mod error;
+mod inputs;
 pub mod lighting;
 pub mod object;
 pub mod plan;

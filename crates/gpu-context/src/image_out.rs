@@ -72,6 +72,17 @@ impl HdrImage {
 /// # Errors
 /// [`GpuError::Write`] naming the path (also when `rgba` is not `4 · width · height` bytes).
 pub fn write_rgba8_png(path: &Path, rgba: &[u8], width: u32, height: u32) -> Result<(), GpuError> {
+    // The encoder asserts on a wrong length; say it as an error instead of panicking.
+    let expected = 4 * u64::from(width) * u64::from(height);
+    if rgba.len() as u64 != expected {
+        return Err(GpuError::Write {
+            path: path.to_owned(),
+            reason: format!(
+                "{} bytes of RGBA for a {width} × {height} image, which needs {expected}",
+                rgba.len()
+            ),
+        });
+    }
     atomic_write(path, |tmp| {
         image::save_buffer_with_format(
             tmp,

@@ -1,0 +1,290 @@
+//! The input stages of a run: geometry (meshes, animations, the simulated cloth, posed at the
+//! scene's frame and kept whole for sequences), the HDR environment, and the lightsphere with
+//! its radiance per direction I_j.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::{Quat, Vec3};
+use serde_json::json;
+
+use crate::Error;
+use crate::object::{Animation, WorldObject};
+use crate::run::progress_bar;
+use crate::scene::{EnvironmentSource, GeometrySource, RadianceMethodDesc, Scene};
+
+/// The synthetic cloth parameters of a scene.
+fn cloth_params(scene: &Scene) -> synth::ClothParams {
+    let mut params = synth::ClothParams::default();
+    if let Some(grid) = scene.synth.cloth_grid {
+        params.grid = grid;
+    }
+    if let Some(frames) = scene.synth.cloth_frames {
+        params.frames = frames;
+    }
+    params.seed = scene.synth.seed;
+    params
+}
+
+pub(crate) fn load_geometry(
+    scene: &Scene,
+    progress: bool,
+) -> Result<(Vec<WorldObject>, serde_json::Value), Error> {
+    let uses_cloth = (0..scene.objects.len())
+        .any(|i| matches!(scene.geometry_source(i), Ok(GeometrySource::SynthCloth)));
+    let cloth = if uses_cloth {
+        let p = cloth_params(scene);
+        let bar = progress_bar(progress, p.frames as u64, "simulating cloth");
+        let anim =
+            synth::simulate_cloth_with_progress(&p, &mut |done, _| bar.set_position(done as u64))?;
+        bar.finish_and_clear();
+        Some(SharedCloth {
+            frames: Arc::new(anim.frames),
+            triangles: anim.triangles,
+            uvs: anim.uvs,
+            grid: anim.grid,
+            obstacle: anim.obstacle,
+        })
+    } else {
+        None
+    };
+    let mut objects = Vec::with_capacity(scene.objects.len());
+    let mut params = serde_json::Map::new();
+    for (index, desc) in scene.objects.iter().enumerate() {
+        let (positions, triangles, uvs, detail, animation) = match (
+            scene.geometry_source(index)?,
+            &cloth,
+        ) {
+            (GeometrySource::SynthCloth, Some(anim)) => {
+                let frame = frame_index(&desc.name, desc.frame, anim.frames.len())?;
+                let detail = json!({ "source": "synth:cloth", "frame": frame, "frames": anim.frames.len(), "grid": anim.grid });
+                (
+                    anim.frames[frame].clone(),
+                    anim.triangles.clone(),
+                    Some(anim.uvs.clone()),
+                    detail,
+                    Some(Arc::clone(&anim.frames)),
+                )
+            }
+            (GeometrySource::SynthCloth, None) => {
+                return Err(Error::Scene {
+                    origin: scene.origin.clone(),
+                    message: format!(
+                        "object {:?}: the synthetic cloth was not simulated",
+                        desc.name
+                    ),
+                });
+            }
+            (GeometrySource::SynthClothObstacle, _) => {
+                let obstacle = cloth
+                    .as_ref()
+                    .map_or(cloth_params(scene).obstacle, |a| a.obstacle);
+                let (positions, triangles) = synth::obstacle_mesh(&obstacle, OBSTACLE_DETAIL);
+                (
+                    positions,
+                    triangles,
+                    None,
+                    json!({ "source": "synth:cloth-obstacle" }),
+                    None,
+                )
+            }
+            (GeometrySource::File(path), _) => load_file(&path, desc)?,
+        };
+        let world_from_object = desc.world_from_object();
+        let positions: Vec<Vec3> = positions
+            .iter()
+            .map(|p| world_from_object.transform_point3(*p))
+            .collect();
+        // Normals are computed in world space from the transformed positions, so any transform
+        // (including mirroring scales) keeps them consistent with the winding.
+        let normals =
+            meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
+        params.insert(
+            desc.name.clone(),
+            json!({ "vertices": positions.len(), "triangles": triangles.len(), "input": detail }),
+        );
+        objects.push(WorldObject {
+            name: desc.name.clone(),
+            positions,
+            normals,
+            triangles,
+            uvs,
+            albedo: Vec3::from(desc.albedo),
+            two_sided: desc.two_sided,
+            front: None,
+            back: None,
+            animation: animation.map(|frames| Animation {
+                frames,
+                world_from_object,
+            }),
+        });
+    }
+    Ok((objects, serde_json::Value::Object(params)))
+}
+
+/// Subdivision detail of the obstacle sphere mesh.
+const OBSTACLE_DETAIL: u32 = 4;
+
+fn frame_index(object: &str, frame: i64, count: usize) -> Result<usize, Error> {
+    let resolved = if frame < 0 {
+        count as i64 + frame
+    } else {
+        frame
+    };
+    if resolved < 0 || resolved >= count as i64 {
+        return Err(Error::Frame {
+            object: object.to_owned(),
+            frame,
+            count,
+        });
+    }
+    Ok(resolved as usize)
+}
+
+/// Positions, triangles, UVs (when the file has them), what the report says of the input, and
+/// the object-space frames of an animation.
+type Geometry = (
+    Vec<Vec3>,
+    Vec<[u32; 3]>,
+    Option<Vec<glam::Vec2>>,
+    serde_json::Value,
+    Option<Arc<Vec<Vec<Vec3>>>>,
+);
+
+/// The simulated cloth, its frames shared by every object that shows it.
+struct SharedCloth {
+    frames: Arc<Vec<Vec<Vec3>>>,
+    triangles: Vec<[u32; 3]>,
+    uvs: Vec<glam::Vec2>,
+    grid: usize,
+    obstacle: synth::Obstacle,
+}
+
+fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, Error> {
+    let has_ext = |ext: &str| {
+        path.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+    };
+    let animation = if path.is_dir() || has_ext("npy") {
+        Some(meshio::load_animation(
+            path,
+            &meshio::AnimationOptions::default(),
+        )?)
+    } else if has_ext("glb") || has_ext("gltf") {
+        // A glTF with an animation is posed at the requested frame; one without is static.
+        meshio::load_animation(path, &meshio::AnimationOptions::default()).ok()
+    } else {
+        None
+    };
+    if let Some((anim, report)) = animation {
+        let frame = frame_index(&desc.name, desc.frame, anim.frames.len())?;
+        let detail = json!({
+            "source": path.display().to_string(),
+            "frame": frame,
+            "frames": anim.frames.len(),
+            "unreferenced_vertices": report.unreferenced_vertices.len(),
+            "degenerate_triangles": report.degenerate_triangles.len(),
+        });
+        let positions = anim.frames[frame].clone();
+        let frames = Arc::new(anim.frames);
+        return Ok((positions, anim.triangles, anim.uvs, detail, Some(frames)));
+    }
+    let (mesh, report) = meshio::load_mesh(path, &meshio::LoadOptions::default())?;
+    let detail = json!({
+        "source": path.display().to_string(),
+        "unreferenced_vertices": report.unreferenced_vertices.len(),
+        "degenerate_triangles": report.degenerate_triangles.len(),
+        "duplicate_positions": report.duplicate_positions,
+    });
+    Ok((mesh.positions, mesh.triangles, mesh.uvs, detail, None))
+}
+
+pub(crate) fn load_environment(
+    scene: &Scene,
+) -> Result<(lightsphere::Environment, serde_json::Value), Error> {
+    let desc = scene.environment.as_ref().ok_or_else(|| Error::Scene {
+        origin: scene.origin.clone(),
+        message: "environment stage planned without [environment]".to_owned(),
+    })?;
+    let (env, source) = match scene.environment_source()? {
+        Some(EnvironmentSource::SynthSky) => {
+            let params = sky_params(scene);
+            let image = synth::sky(&params)?;
+            let env =
+                lightsphere::Environment::from_latlong(image.width, image.height, image.texels)?;
+            (env, "synth:sky".to_owned())
+        }
+        Some(EnvironmentSource::File(path)) => (
+            lightsphere::Environment::load(&path)?,
+            path.display().to_string(),
+        ),
+        None => {
+            return Err(Error::Scene {
+                origin: scene.origin.clone(),
+                message: "environment stage planned without an environment source".to_owned(),
+            });
+        }
+    };
+    let rotation = Quat::from_rotation_y(desc.rotation_deg.to_radians());
+    let mut env = env.with_rotation(rotation);
+    if desc.prefilter_sigma_deg > 0.0 {
+        env = env.prefiltered(desc.prefilter_sigma_deg)?;
+    }
+    let power = env.total_power();
+    let params = json!({
+        "source": source,
+        "width": env.width(),
+        "height": env.height(),
+        "rotation_deg": desc.rotation_deg,
+        "prefilter_sigma_deg": desc.prefilter_sigma_deg,
+        "power_rgb": power,
+    });
+    Ok((env, params))
+}
+
+fn sky_params(scene: &Scene) -> synth::SkyParams {
+    let mut params = synth::SkyParams::default();
+    if let Some(e) = scene.synth.sun_elevation_deg {
+        params.sun_elevation_deg = e;
+    }
+    if let Some(a) = scene.synth.sun_azimuth_deg {
+        params.sun_azimuth_deg = a;
+    }
+    if let Some(w) = scene.synth.sky_width {
+        params.width = w;
+        params.height = (w / 2).max(1);
+    }
+    params
+}
+
+pub(crate) fn light_directions(
+    scene: &Scene,
+    env: &lightsphere::Environment,
+) -> Result<((lightsphere::Lightsphere, Vec<Vec3>), serde_json::Value), Error> {
+    let sphere = lightsphere::Lightsphere::new(scene.lighting.level)?;
+    let method = match scene.lighting.method {
+        RadianceMethodDesc::CellMean => lightsphere::RadianceMethod::CellMean,
+        RadianceMethodDesc::PrefilteredLookup => lightsphere::RadianceMethod::PrefilteredLookup {
+            sigma_deg: lightsphere::matched_sigma_deg(sphere.len()),
+        },
+    };
+    let radiance = env.radiance_per_direction(&sphere, method)?;
+    let power: [f64; 3] = std::array::from_fn(|c| {
+        radiance
+            .iter()
+            .zip(sphere.solid_angles())
+            .map(|(r, w)| f64::from(r[c]) * w)
+            .sum()
+    });
+    let total = env.total_power();
+    let power_error: Vec<f64> = (0..3)
+        .map(|c| (power[c] - total[c]) / total[c].max(f64::MIN_POSITIVE))
+        .collect();
+    let params = json!({
+        "level": sphere.level(),
+        "directions": sphere.len(),
+        "method": scene.lighting.method,
+        "relative_power_error_rgb": power_error,
+    });
+    Ok(((sphere, radiance), params))
+}
