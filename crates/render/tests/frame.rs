@@ -3,6 +3,8 @@
 //! test under both depth conventions, the backdrop only behind objects, and pipelines built
 //! once for a whole sequence.
 
+mod common;
+
 use glam::{Mat4, Vec2, Vec3};
 use gpu_context::PipelineStats;
 use gpu_context::testing::gpu_or_skip;
@@ -94,19 +96,15 @@ fn alpha_matte_equals_the_cpu_sample_coverage() {
     ];
     let triangles = [[0u32, 1, 2], [0, 2, 3], [4, 5, 6]];
     let colour = flat(&positions, Vec3::new(0.3, 0.6, 0.9));
-    renderer
-        .gouraud
-        .set_meshes(
-            &gpu.device,
-            &gpu.queue,
-            &[DrawMesh {
-                positions: &positions,
-                triangles: &triangles,
-                front: &colour,
-                back: &colour,
-            }],
-        )
-        .unwrap();
+    common::one_mesh(
+        &mut renderer,
+        &gpu,
+        &positions,
+        &triangles,
+        &colour,
+        &colour,
+    )
+    .unwrap();
     let camera = Camera::look_at(Vec3::new(0.1, 0.2, 3.0), Vec3::ZERO, Vec3::Y, 40.0, 97, 61);
     let image = renderer
         .render(
@@ -281,19 +279,7 @@ fn backdrop_fills_only_the_background_and_black_means_black() {
         Vec3::new(0.0, 0.3, 0.0),
     ];
     let c = flat(&positions, Vec3::splat(0.25));
-    renderer
-        .gouraud
-        .set_meshes(
-            &gpu.device,
-            &gpu.queue,
-            &[DrawMesh {
-                positions: &positions,
-                triangles: &[[0, 1, 2]],
-                front: &c,
-                back: &c,
-            }],
-        )
-        .unwrap();
+    common::one_mesh(&mut renderer, &gpu, &positions, &[[0, 1, 2]], &c, &c).unwrap();
     // A constant sky of radiance 7.
     let texels = vec![[7.0f32; 3]; 8 * 4];
     renderer.backdrop.set_environment(
@@ -373,19 +359,7 @@ fn a_sequence_builds_its_pipelines_once_and_rewrites_buffers_in_place() {
             Vec3::new(0.0, s, 0.0),
         ];
         let c = flat(&positions, Vec3::splat(frame as f32));
-        renderer
-            .gouraud
-            .set_meshes(
-                &gpu.device,
-                &gpu.queue,
-                &[DrawMesh {
-                    positions: &positions,
-                    triangles: &triangles,
-                    front: &c,
-                    back: &c,
-                }],
-            )
-            .unwrap();
+        common::one_mesh(&mut renderer, &gpu, &positions, &triangles, &c, &c).unwrap();
         let camera = Camera::look_at(Vec3::new(0.0, 0.0, 3.0), Vec3::ZERO, Vec3::Y, 45.0, 24, 24);
         let image = renderer
             .render(
@@ -418,34 +392,10 @@ fn bad_meshes_and_cameras_are_errors_not_panics() {
     let mut renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
     let p = [Vec3::ZERO; 3];
     let c = [Vec3::ONE; 2];
-    let err = renderer
-        .gouraud
-        .set_meshes(
-            &gpu.device,
-            &gpu.queue,
-            &[DrawMesh {
-                positions: &p,
-                triangles: &[[0, 1, 2]],
-                front: &c,
-                back: &c,
-            }],
-        )
-        .unwrap_err();
+    let err = common::one_mesh(&mut renderer, &gpu, &p, &[[0, 1, 2]], &c, &c).unwrap_err();
     assert!(err.to_string().contains("mesh 0"), "{err}");
     let c = [Vec3::ONE; 3];
-    let err = renderer
-        .gouraud
-        .set_meshes(
-            &gpu.device,
-            &gpu.queue,
-            &[DrawMesh {
-                positions: &p,
-                triangles: &[[0, 1, 3]],
-                front: &c,
-                back: &c,
-            }],
-        )
-        .unwrap_err();
+    let err = common::one_mesh(&mut renderer, &gpu, &p, &[[0, 1, 3]], &c, &c).unwrap_err();
     assert!(err.to_string().contains("triangle 0"), "{err}");
     let camera = Camera::look_at(Vec3::Z, Vec3::Z, Vec3::Y, 45.0, 8, 8);
     let err = renderer

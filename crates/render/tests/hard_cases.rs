@@ -1,6 +1,8 @@
 //! The hard cases the frame defends: a sun 10⁴× the sky, non-finite radiance, degenerate and
 //! empty meshes, huge coordinate offsets, a scene of zero size.
 
+mod common;
+
 use glam::Vec3;
 use gpu_context::HdrImage;
 use gpu_context::testing::gpu_or_skip;
@@ -116,19 +118,7 @@ fn huge_coordinate_offsets_render_the_same_coverage() {
             offset + Vec3::new(0.0, 1.0, 0.0),
         ];
         let c = [Vec3::ONE; 3];
-        renderer
-            .gouraud
-            .set_meshes(
-                &gpu.device,
-                &gpu.queue,
-                &[DrawMesh {
-                    positions: &p,
-                    triangles: &[[0, 1, 2]],
-                    front: &c,
-                    back: &c,
-                }],
-            )
-            .unwrap();
+        common::one_mesh(&mut renderer, &gpu, &p, &[[0, 1, 2]], &c, &c).unwrap();
         let (centre, radius) = render::bounding_sphere(&p).unwrap();
         let camera = Camera::framing(centre, radius, centre, Vec3::Z, Vec3::Y, 35.0, 64, 64);
         counts.push(covered(&mut renderer, &gpu, &camera));
