@@ -113,6 +113,8 @@ fn repro_dir() -> anyhow::Result<PathBuf> {
 }
 
 fn main() -> anyhow::Result<()> {
+    // An interrupted report leaves no hidden `.NAME.PID.N.tmp` beside its outputs.
+    atomic_out::remove_temporaries_on_signal()?;
     match Cli::parse().command {
         Command::Repro {
             what: Repro::Lightsphere { max_level },

@@ -30,7 +30,6 @@ use cloth_vis::plot::{Axis, Series, chart_svg, log_log_svg};
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::repro_visibility::write_atomic;
 use crate::sequences::{Sequence, load_sequences};
 
 /// Longest clip compressed (the thesis's chicken: 400 frames).
@@ -573,7 +572,7 @@ pub fn run(out: &Path, only: Option<&str>) -> anyhow::Result<()> {
             [Axis::Linear, Axis::Log],
             &series,
         );
-        write_atomic(&out.join("anim-compression-cstar.svg"), &svg)?;
+        atomic_out::write_bytes(&out.join("anim-compression-cstar.svg"), svg.as_bytes())?;
         let _ = writeln!(
             md,
             "\nFig. 3.15 (d_f per frame for c* ∈ {{10, 20, 40, none}}): \
@@ -666,7 +665,7 @@ pub fn run(out: &Path, only: Option<&str>) -> anyhow::Result<()> {
         "bpvf (file)",
         &series,
     );
-    write_atomic(&out.join("anim-compression.svg"), &svg)?;
+    atomic_out::write_bytes(&out.join("anim-compression.svg"), svg.as_bytes())?;
     let sweep: f64 = measured.iter().map(|m| m.sweep_s).sum();
     let _ = writeln!(
         md,
@@ -674,7 +673,7 @@ pub fn run(out: &Path, only: Option<&str>) -> anyhow::Result<()> {
          report {:.0} s.",
         total.elapsed().as_secs_f64()
     );
-    write_atomic(&out.join("anim-compression.md"), &md)?;
+    atomic_out::write_bytes(&out.join("anim-compression.md"), md.as_bytes())?;
     eprintln!("wrote {}", out.join("anim-compression.md").display());
     Ok(())
 }

@@ -34,8 +34,6 @@ use btf::{
 use cloth_vis::plot::{Axis, Series, chart_svg};
 use synth::{WovenBtf, WovenBtfParams};
 
-use crate::repro_visibility::write_atomic;
-
 /// Resolution of the full-size timing (the thesis's and the 256²).
 const FULL_RES: usize = 256;
 /// Resolution of the FMF/PCMF/PVMF comparison.
@@ -579,14 +577,14 @@ pub fn run(out: &Path, quick: bool) -> anyhow::Result<()> {
         [Axis::Linear, Axis::Linear],
         &error_series,
     );
-    write_atomic(&out.join("btf-error.svg"), &svg)?;
+    atomic_out::write_bytes(&out.join("btf-error.svg"), svg.as_bytes())?;
     let svg = chart_svg(
         &format!("Eigenvalue decay of three view slots ({sweep_res}², Fig. 5.8)"),
         ["k", "λ_k / λ_1"],
         [Axis::Linear, Axis::Log],
         &eigen_series,
     );
-    write_atomic(&out.join("btf-eigenvalues.svg"), &svg)?;
+    atomic_out::write_bytes(&out.join("btf-eigenvalues.svg"), svg.as_bytes())?;
     fig57(&mut md, out, &btf)?;
 
     let _ = writeln!(
@@ -595,7 +593,7 @@ pub fn run(out: &Path, quick: bool) -> anyhow::Result<()> {
         mib_or_na(proc_status_mib("VmHWM:")),
         total.elapsed().as_secs_f64()
     );
-    write_atomic(&out.join("btf.md"), &md)?;
+    atomic_out::write_bytes(&out.join("btf.md"), md.as_bytes())?;
     eprintln!("wrote {}", out.join("btf.md").display());
     Ok(())
 }

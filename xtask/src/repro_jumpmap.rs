@@ -32,7 +32,7 @@ use anyhow::Context as _;
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::repro_visibility::{cpu_model, write_atomic};
+use crate::repro_visibility::cpu_model;
 use crate::sequences::{Sequence, load_sequences};
 use cloth_vis::plot::{Series, log_log_svg};
 
@@ -313,8 +313,8 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
     }
     let elapsed = total.elapsed().as_secs_f64();
     let md = report(&results, &skipped, &gpu, elapsed);
-    write_atomic(&out.join("jumpmap.md"), &md)?;
-    write_atomic(&out.join("jumpmap.svg"), &plot(&results))?;
+    atomic_out::write_bytes(&out.join("jumpmap.md"), md.as_bytes())?;
+    atomic_out::write_bytes(&out.join("jumpmap.svg"), plot(&results).as_bytes())?;
     println!(
         "wrote {} and jumpmap.svg in {elapsed:.0} s",
         out.join("jumpmap.md").display()

@@ -204,8 +204,8 @@ pub fn run(out: &Path, max_level: u32) -> anyhow::Result<()> {
         "worst irradiance error",
         &series,
     );
-    std::fs::write(out.join("lightsphere.md"), md)?;
-    std::fs::write(out.join("lightsphere.svg"), svg)?;
+    atomic_out::write_bytes(&out.join("lightsphere.md"), md.as_bytes())?;
+    atomic_out::write_bytes(&out.join("lightsphere.svg"), svg.as_bytes())?;
     println!(
         "wrote {} and lightsphere.svg",
         out.join("lightsphere.md").display()

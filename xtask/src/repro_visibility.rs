@@ -16,7 +16,6 @@
 //! Writes `target/repro/visibility.md` and `target/repro/visibility.svg` (atomically).
 
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
@@ -439,12 +438,6 @@ pub(crate) fn cpu_model() -> Option<String> {
         .map(|(_, v)| v.trim().to_owned())
 }
 
-/// Writes a report file atomically (complete or not at all).
-pub(crate) fn write_atomic(path: &Path, text: &str) -> anyhow::Result<()> {
-    meshio::write_atomic(path, |w| w.write_all(text.as_bytes()))?;
-    Ok(())
-}
-
 /// Run the report.
 pub fn run(out: &Path, quick: bool, max_level: u32) -> anyhow::Result<()> {
     let total = Instant::now();
@@ -516,8 +509,8 @@ pub fn run(out: &Path, quick: bool, max_level: u32) -> anyhow::Result<()> {
 
     let md = report(&plan, &cases, &results, &gpu, &skipped, elapsed);
     let svg = plot(&plan, &cases[0], &results[0]);
-    write_atomic(&out.join("visibility.md"), &md)?;
-    write_atomic(&out.join("visibility.svg"), &svg)?;
+    atomic_out::write_bytes(&out.join("visibility.md"), md.as_bytes())?;
+    atomic_out::write_bytes(&out.join("visibility.svg"), svg.as_bytes())?;
     println!(
         "wrote {} and visibility.svg in {elapsed:.0} s",
         out.join("visibility.md").display()

@@ -65,6 +65,7 @@ fn peak_rss_mb() -> Option<f64> {
 }
 
 fn main() -> Result<()> {
+    atomic_out::remove_temporaries_on_signal()?;
     let mut args = std::env::args().skip(1);
     let (Some(dir), Some(out)) = (args.next(), args.next()) else {
         bail!(

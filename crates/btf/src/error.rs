@@ -19,7 +19,7 @@ pub enum BtfError {
     Io {
         /// The file or folder.
         path: PathBuf,
-        /// What was attempted ("read", "list", "create", …).
+        /// What was attempted ("read", "list", "create", "rename a temporary file onto", …).
         action: &'static str,
         /// The underlying error.
         source: std::io::Error,
@@ -135,9 +135,6 @@ pub enum BtfError {
         /// The codec's error.
         source: CodecError,
     },
-    /// A file could not be written atomically.
-    #[error(transparent)]
-    Write(#[from] meshio::MeshIoError),
     /// A parameter or argument is out of range.
     #[error("{what}: `{name}` = {value} is invalid: {reason}")]
     InvalidParameter {
@@ -234,6 +231,13 @@ pub enum BtfError {
 
 /// The crate's result type.
 pub type Result<T, E = BtfError> = std::result::Result<T, E>;
+
+/// A failed atomic write is a [`BtfError::Io`] naming the target and the step.
+impl From<atomic_out::WriteError> for BtfError {
+    fn from(e: atomic_out::WriteError) -> Self {
+        Self::io(e.path, e.op, e.source)
+    }
+}
 
 impl BtfError {
     pub(crate) fn io(

@@ -29,7 +29,6 @@
 //! finite with lo ≤ hi, weights and f32 texture values finite, eigenvalues finite, ≥ 0 and
 //! descending.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use crate::compress::MAX_COMPONENTS;
@@ -111,10 +110,9 @@ impl BtfPca {
     /// Writes a `.btfpca` file atomically (temporary file + rename).
     ///
     /// # Errors
-    /// [`BtfError::Write`] if the file cannot be written.
+    /// [`BtfError::Io`] if the file cannot be written (then `path` is untouched).
     pub fn write(&self, path: &Path) -> Result<()> {
-        let bytes = self.to_bytes();
-        meshio::write_atomic(path, |w| w.write_all(&bytes))?;
+        atomic_out::write_bytes(path, &self.to_bytes())?;
         Ok(())
     }
 

@@ -246,7 +246,7 @@ pub fn write_png_srgb8(
         image::ExtendedColorType::Rgb8,
     )
     .map_err(|e| BtfError::codec(path, "encode", e))?;
-    write_renamed(path, &encoded)?;
+    atomic_out::write_bytes(path, &encoded)?;
     Ok(())
 }
 
@@ -326,28 +326,6 @@ where
     (0..DIRECTIONS)
         .into_par_iter()
         .try_for_each(|light| write_one(dir, sampling, res, view, light, &image(light)))
-}
-
-/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`; on error the
-/// temporary file is removed.
-fn write_renamed(path: &Path, bytes: &[u8]) -> Result<()> {
-    static COUNTER: AtomicUsize = AtomicUsize::new(0);
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-    let temp = path.with_file_name(format!(".{name}.{}.{n}.tmp", std::process::id()));
-    let result = std::fs::write(&temp, bytes)
-        .map_err(|e| BtfError::io(&temp, "write", e))
-        .and_then(|()| {
-            std::fs::rename(&temp, path).map_err(|e| BtfError::io(path, "rename onto", e))
-        });
-    if result.is_err() {
-        // Best effort: the temporary file may not exist.
-        let _ = std::fs::remove_file(&temp);
-    }
-    result
 }
 
 fn check_res(res: usize) -> Result<()> {

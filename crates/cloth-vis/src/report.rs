@@ -102,23 +102,14 @@ fn compact(v: &serde_json::Value) -> String {
     }
 }
 
-/// Write bytes to a temporary file beside `path` and rename it into place.
+/// Write bytes to a temporary file beside `path` and rename it into place
+/// ([`atomic_out::write_bytes`]).
 ///
 /// # Errors
-/// [`Error::Io`] naming `path`; no partial file is left behind.
+/// [`Error::Io`] naming `path` and the step that failed; no partial file is left behind.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    let fail = |e: std::io::Error| Error::Io {
-        path: path.to_owned(),
-        reason: e.to_string(),
-    };
-    let mut name = std::ffi::OsString::from(".");
-    name.push(path.file_name().unwrap_or_default());
-    name.push(format!(".{}.tmp", std::process::id()));
-    let tmp = path.with_file_name(name);
-    let result = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(fail(e));
-    }
-    Ok(())
+    atomic_out::write_bytes(path, bytes).map_err(|e| Error::Io {
+        path: e.path,
+        reason: format!("cannot {} it: {}", e.op, e.source),
+    })
 }

@@ -1,7 +1,7 @@
-//! Linear HDR images and atomic PNG/EXR output. Tone mapping for display lives in one place,
-//! `render::tone` and `render::output`.
+//! Linear HDR images and atomic PNG/EXR output (through [`atomic_out::write_via_path`]). Tone
+//! mapping for display lives in one place, `render::tone` and `render::output`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::GpuError;
 
@@ -96,33 +96,19 @@ pub fn write_rgba8_png(path: &Path, rgba: &[u8], width: u32, height: u32) -> Res
     })
 }
 
-/// Run `write` on a temporary path beside `path` (a hidden `.NAME.PID.tmp`), then rename it
-/// into place; on failure the temporary file is removed and nothing is left at `path`.
-///
-/// # Errors
-/// [`GpuError::Write`] naming `path` with `write`'s reason, or the rename's.
-pub fn atomic_write(
+/// Runs the encoder `write` on a temporary path beside `path` with
+/// [`atomic_out::write_via_path`], then renames it into place; on failure nothing is left.
+fn atomic_write(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), GpuError> {
-    let fail = |reason: String| GpuError::Write {
+    atomic_out::write_via_path(path, write).map_err(|e| GpuError::Write {
         path: path.to_owned(),
-        reason,
-    };
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| fail("not a file path".to_owned()))?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(file_name);
-    tmp_name.push(format!(".{}.tmp", std::process::id()));
-    let tmp: PathBuf = path.with_file_name(tmp_name);
-    match write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string())) {
-        Ok(()) => Ok(()),
-        Err(reason) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(fail(reason))
-        }
-    }
+        reason: match e {
+            atomic_out::AtomicError::File(e) => format!("cannot {} it: {}", e.op, e.source),
+            atomic_out::AtomicError::Writer(reason) => reason,
+        },
+    })
 }
 
 #[cfg(test)]

@@ -41,7 +41,7 @@ pub mod testing;
 
 pub use adapter::{ADAPTER_ENV, AdapterSummary, BACKEND_ENV, GpuContext, GpuOptions};
 pub use error::GpuError;
-pub use image_out::{HdrImage, atomic_write, write_rgba8_png};
+pub use image_out::{HdrImage, write_rgba8_png};
 pub use offscreen::{
     COLOR_FORMAT, DEPTH_FORMAT, OffscreenTarget, read_buffer, read_hdr_image, read_texture,
 };

@@ -3,7 +3,7 @@
 //! image buffers of the wrong size.
 
 use gpu_context::testing::gpu_or_skip;
-use gpu_context::{GpuError, HdrImage, atomic_write, read_buffer, read_hdr_image, write_rgba8_png};
+use gpu_context::{GpuError, HdrImage, read_buffer, read_hdr_image, write_rgba8_png};
 
 #[test]
 fn odd_row_pitch_reads_back_exactly() {
@@ -69,14 +69,22 @@ fn failed_writes_leave_nothing_and_name_the_file() {
         "{err}"
     );
     assert!(!path.exists());
-    // A writer that fails after writing part of the file: the temporary file is removed.
-    let path = dir.join("half.bin");
-    let err = atomic_write(&path, |tmp| {
-        std::fs::write(tmp, b"half").map_err(|e| e.to_string())?;
-        Err("disk full".to_owned())
-    })
-    .unwrap_err();
-    assert!(err.to_string().contains("half.bin") && err.to_string().contains("disk full"));
+    // A complete file that cannot be renamed into place (the target is a folder): the
+    // temporary file is removed. (A writer failing halfway is atomic-out's hard case.)
+    let path = dir.join("folder.png");
+    std::fs::create_dir(&path).unwrap();
+    let err = write_rgba8_png(&path, &[0; 16], 2, 2).unwrap_err();
+    let GpuError::Write { path: p, reason } = &err else {
+        panic!("expected a write error, got {err}");
+    };
+    assert!(p == &path && reason.contains("rename"), "{err}");
+    let image = HdrImage::new(1, 1, vec![[1.0; 4]]).unwrap();
+    let err = image.write_exr(&path).unwrap_err();
+    assert!(
+        matches!(&err, GpuError::Write { path: p, .. } if p == &path),
+        "{err}"
+    );
+    std::fs::remove_dir(&path).unwrap();
     let left: Vec<_> = std::fs::read_dir(&dir).unwrap().flatten().collect();
     assert!(left.is_empty(), "left behind: {left:?}");
     std::fs::remove_dir_all(&dir).unwrap();

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
+    atomic_out::remove_temporaries_on_signal()?;
     let args: Vec<String> = std::env::args().skip(1).collect();
     let [input, sigma, output] = args.as_slice() else {
         return Err("usage: prefilter IN.hdr|IN.exr SIGMA_DEG OUT.exr".into());

@@ -29,7 +29,8 @@
 //! Output: [`write_npy_f32`]; [`write_glb`] (a [`GlbMesh`] with normals, linear float
 //! `COLOR_0` and custom scalar attributes such as `_AO`); [`write_glb_animation`] (frames as
 //! morph targets driven by a `STEP` weights clip, read back by [`load_animation`]). All writers
-//! validate first and write atomically ([`write_atomic`]).
+//! validate first and write atomically (through [`atomic_out`]; [`write_atomic`] returns its
+//! errors as [`MeshIoError`]).
 //!
 //! # Examples
 //! ```

@@ -14,7 +14,6 @@ use glam::Vec3;
 use crate::validate::finish_animation;
 use crate::{
     Animation, AnimationOptions, LoadOptions, LoadReport, MeshIoError, SourceFormat, load_mesh,
-    write_atomic,
 };
 
 const MAGIC: &[u8] = b"\x93NUMPY";
@@ -244,7 +243,7 @@ fn fortran_to_c(shape: &[usize], values: &[f32]) -> Vec<f32> {
 }
 
 /// Writes `data` (row-major, `shape`) as a little-endian float32 `.npy` file, atomically
-/// (temporary file beside `path`, then rename; see [`write_atomic`]).
+/// (temporary file beside `path`, then rename; see [`atomic_out::write_with`]).
 ///
 /// # Errors
 /// [`MeshIoError::ShapeMismatch`] when `shape`'s product differs from `data.len()`;
@@ -270,13 +269,14 @@ pub fn write_npy_f32(path: &Path, shape: &[usize], data: &[f32]) -> Result<(), M
         });
     }
     let header = npy_header(shape);
-    write_atomic(path, |w| {
+    atomic_out::write_with(path, |w| {
         w.write_all(&header)?;
         for value in data {
             w.write_all(&value.to_le_bytes())?;
         }
         Ok(())
-    })
+    })?;
+    Ok(())
 }
 
 /// Magic, version, length and dict, padded with spaces and a newline to a multiple of 64 bytes

@@ -12,10 +12,11 @@
 use glam::Vec3;
 use std::error::Error;
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use synth::{ClothAnimation, ClothParams, LatLongImage, SkyParams};
 
 fn main() -> Result<(), Box<dyn Error>> {
+    atomic_out::remove_temporaries_on_signal()?;
     let Some(out_dir) = std::env::args_os().nth(1).map(PathBuf::from) else {
         return Err("usage: drape OUT_DIR".into());
     };
@@ -37,17 +38,17 @@ fn main() -> Result<(), Box<dyn Error>> {
         start.elapsed()
     );
     for frame in (0..anim.frame_count()).step_by(30) {
-        write_atomically(
+        atomic_out::write_bytes(
             &out_dir.join(format!("cloth_frame_{frame:03}.obj")),
             &cloth_obj(&anim, frame),
         )?;
     }
-    write_atomically(
+    atomic_out::write_bytes(
         &out_dir.join("cloth_last.obj"),
         &cloth_obj(&anim, anim.frame_count() - 1),
     )?;
     let (positions, triangles) = synth::obstacle_mesh(&anim.obstacle, 4);
-    write_atomically(
+    atomic_out::write_bytes(
         &out_dir.join("sphere.obj"),
         &mesh_obj(&positions, &triangles).into_bytes(),
     )?;
@@ -60,7 +61,7 @@ fn main() -> Result<(), Box<dyn Error>> {
         image.height,
         start.elapsed()
     );
-    write_atomically(&out_dir.join("sky.pfm"), &pfm(&image))?;
+    atomic_out::write_bytes(&out_dir.join("sky.pfm"), &pfm(&image))?;
     eprintln!("wrote {}", out_dir.display());
     Ok(())
 }
@@ -115,11 +116,4 @@ fn pfm(image: &LatLongImage) -> Vec<u8> {
         }
     }
     bytes
-}
-
-/// Writes via a temporary file and a rename, so no partial file is left behind.
-fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let temporary = path.with_extension("partial");
-    std::fs::write(&temporary, bytes)?;
-    std::fs::rename(&temporary, path)
 }

@@ -50,6 +50,7 @@ fn direction(theta_deg: f32, phi_deg: f32) -> Vec3 {
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
+    atomic_out::remove_temporaries_on_signal()?;
     let mut args = std::env::args_os().skip(1);
     let Some(out_dir) = args.next().map(PathBuf::from) else {
         return Err("usage: woven_btf OUT_DIR [RES] [SUPERSAMPLE]".into());
@@ -113,11 +114,9 @@ fn srgb(linear: f32) -> u8 {
     (encoded * 255.0).round() as u8
 }
 
-/// Binary PPM, written to a temporary file and renamed so no partial file is left behind.
-fn write_ppm(path: &Path, res: usize, image: &[[f32; 3]]) -> std::io::Result<()> {
+/// Binary PPM, written atomically so no partial file is left behind.
+fn write_ppm(path: &Path, res: usize, image: &[[f32; 3]]) -> Result<(), atomic_out::WriteError> {
     let mut bytes = format!("P6\n{res} {res}\n255\n").into_bytes();
     bytes.extend(image.iter().flat_map(|t| t.map(srgb)));
-    let tmp = path.with_extension("ppm.tmp");
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(tmp, path)
+    atomic_out::write_bytes(path, &bytes)
 }

@@ -8,8 +8,8 @@ use super::{Environment, check_size};
 use crate::LightsphereError;
 use image::ImageDecoder;
 use std::fs::File;
-use std::io::{BufReader, BufWriter};
-use std::path::{Path, PathBuf};
+use std::io::BufReader;
+use std::path::Path;
 
 const HDR: &str = "Radiance HDR";
 const EXR: &str = "OpenEXR";
@@ -153,54 +153,27 @@ fn exr_error(path: &Path, error: exr::error::Error) -> LightsphereError {
     }
 }
 
-/// A temporary path beside `path` that no other writer uses.
-fn temporary_path(path: &Path) -> PathBuf {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let unique = COUNTER.fetch_add(1, Ordering::Relaxed);
-    path.with_file_name(format!(".{name}.{}.{unique}.tmp", std::process::id()))
-}
-
+/// Writes `env` as float RGB OpenEXR, atomically ([`atomic_out::write_via_path`]: the `exr`
+/// encoder writes a temporary file beside `path`, which is renamed over it).
 pub(super) fn write_exr(env: &Environment, path: &Path) -> Result<(), LightsphereError> {
     use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
-    let temporary = temporary_path(path);
-    let result = (|| {
-        let file = File::options()
-            .write(true)
-            .create_new(true)
-            .open(&temporary)
-            .map_err(|e| io_error(&temporary, "create", e))?;
-        let width = env.width;
-        let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-            let t = env.texels[y * width + x];
-            (t[0], t[1], t[2])
-        });
-        let image = Image::from_channels((env.width, env.height), channels);
-        let mut writer = BufWriter::new(file);
-        image
-            .write()
-            .to_buffered(&mut writer)
-            .map_err(|e| match e {
-                exr::error::Error::Io(e) => io_error(path, "write", e),
-                other => LightsphereError::Encode {
-                    path: path.to_path_buf(),
-                    source: Box::new(other),
-                },
-            })?;
-        let file = writer
-            .into_inner()
-            .map_err(|e| io_error(path, "write", e.into_error()))?;
-        file.sync_all().map_err(|e| io_error(path, "write", e))?;
-        drop(file);
-        std::fs::rename(&temporary, path).map_err(|e| io_error(path, "rename onto", e))
-    })();
-    if result.is_err() {
-        // Best effort: the temporary file may not exist if creating it failed.
-        let _ = std::fs::remove_file(&temporary);
-    }
-    result
+    let width = env.width;
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        let t = env.texels[y * width + x];
+        (t[0], t[1], t[2])
+    });
+    let image = Image::from_channels((env.width, env.height), channels);
+    atomic_out::write_via_path(path, |temporary| {
+        image.write().to_file(temporary).map_err(|e| match e {
+            exr::error::Error::Io(e) => io_error(path, "write", e),
+            other => LightsphereError::Encode {
+                path: path.to_path_buf(),
+                source: Box::new(other),
+            },
+        })
+    })
+    .map_err(|e| match e {
+        atomic_out::AtomicError::File(e) => io_error(&e.path, e.op, e.source),
+        atomic_out::AtomicError::Writer(e) => e,
+    })
 }

@@ -35,7 +35,7 @@ use std::path::Path;
 use glam::{Vec2, Vec3};
 use serde_json::{Value, json};
 
-use crate::{Animation, MeshIoError, NormalWeighting, compute_normals, write_atomic};
+use crate::{Animation, MeshIoError, NormalWeighting, compute_normals};
 
 /// `"glTF"` as a little-endian u32.
 const GLB_MAGIC: u32 = 0x4654_6C67;
@@ -123,7 +123,7 @@ impl<'a> GlbMesh<'a> {
     }
 }
 
-/// Writes `mesh` as a glTF 2.0 binary file, atomically (see [`write_atomic`]).
+/// Writes `mesh` as a glTF 2.0 binary file, atomically (see [`atomic_out::write_with`]).
 ///
 /// # Errors
 /// [`MeshIoError::InvalidWriteInput`] (nothing is written) when the mesh has no vertex or no
@@ -536,7 +536,7 @@ impl Builder {
         let total = u32::try_from(total).map_err(|_| too_large())?;
         let json_len = u32::try_from(text.len()).map_err(|_| too_large())?;
         let bin_len = u32::try_from(self.bin.len()).map_err(|_| too_large())?;
-        write_atomic(path, |w| {
+        atomic_out::write_with(path, |w| {
             for word in [GLB_MAGIC, GLB_VERSION, total, json_len, CHUNK_JSON] {
                 w.write_all(&word.to_le_bytes())?;
             }
@@ -544,6 +544,7 @@ impl Builder {
             w.write_all(&bin_len.to_le_bytes())?;
             w.write_all(&CHUNK_BIN.to_le_bytes())?;
             w.write_all(&self.bin)
-        })
+        })?;
+        Ok(())
     }
 }

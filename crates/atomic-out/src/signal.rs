@@ -1,0 +1,56 @@
+//! Removing temporary files when the program is interrupted (SIGINT) or terminated (SIGTERM).
+
+use std::sync::Mutex;
+
+use crate::error::SignalError;
+use crate::temporary::registry;
+
+/// Exit status after the handler ran: 128 + SIGINT, the shell's convention for Ctrl-C (used for
+/// SIGTERM too, since `ctrlc` does not say which signal arrived).
+const EXIT_STATUS_ON_SIGNAL: i32 = 130;
+
+/// Whether this crate's handler is installed (so that a second call is a no-op).
+static INSTALLED: Mutex<bool> = Mutex::new(false);
+
+/// Installs a SIGINT/SIGTERM handler that removes every temporary file of an atomic write in
+/// progress, then exits the process with status 130. Without it, a program interrupted
+/// mid-write leaves a hidden `.NAME.PID.N.tmp` beside its output (the output itself is never
+/// partial either way).
+///
+/// A binary calls this once at start; calling it again is a no-op. Libraries never call it:
+/// installing a signal handler is the program's decision. The handler runs on its own thread
+/// (via the `ctrlc` crate), not in signal context.
+///
+/// # Errors
+/// [`SignalError`] if a SIGINT/SIGTERM handler was already installed through `ctrlc` by
+/// someone else, or the operating system refused; the program then runs without it.
+///
+/// # Examples
+/// ```no_run
+/// fn main() -> Result<(), Box<dyn std::error::Error>> {
+///     atomic_out::remove_temporaries_on_signal()?;
+///     atomic_out::write_bytes("out.txt".as_ref(), b"...")?;
+///     Ok(())
+/// }
+/// ```
+pub fn remove_temporaries_on_signal() -> Result<(), SignalError> {
+    let mut installed = INSTALLED
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    if !*installed {
+        ctrlc::set_handler(remove_temporaries_and_exit).map_err(SignalError::new)?;
+        *installed = true;
+    }
+    Ok(())
+}
+
+fn remove_temporaries_and_exit() {
+    // Holding the registry lock until exit: a writer cannot create (and register) a new
+    // temporary file after this sweep, since creation takes the same lock.
+    let registry = registry();
+    for path in registry.iter() {
+        // Best effort: a file renamed onto its target a moment ago is simply gone.
+        let _ = std::fs::remove_file(path);
+    }
+    std::process::exit(EXIT_STATUS_ON_SIGNAL);
+}

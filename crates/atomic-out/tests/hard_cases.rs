@@ -1,0 +1,290 @@
+//! Named hard cases: every way an atomic write can fail leaves the target as it was and no
+//! temporary file behind — including a SIGTERM in the middle of a write.
+
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Stdio};
+use std::sync::{Arc, Barrier, mpsc};
+use std::time::{Duration, Instant};
+
+use atomic_out::{
+    AtomicError, WriteError, registered_temporaries, remove_temporaries_on_signal, write_bytes,
+    write_via_path, write_with,
+};
+
+/// How long the signal test waits for its child process at each step before failing (it takes
+/// milliseconds; the margin is for a loaded CI machine).
+const CHILD_TIMEOUT: Duration = Duration::from_secs(20);
+
+/// Set (to a folder) in the child process of the signal test.
+const SIGTERM_CHILD_DIR: &str = "ATOMIC_OUT_SIGTERM_CHILD_DIR";
+/// Set in the child process of the foreign-handler test.
+const FOREIGN_HANDLER_CHILD: &str = "ATOMIC_OUT_FOREIGN_HANDLER_CHILD";
+
+/// The names in `dir`, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// The registered temporaries in `dir` (other tests of this binary run concurrently).
+fn registered_in(dir: &Path) -> Vec<PathBuf> {
+    registered_temporaries()
+        .into_iter()
+        .filter(|t| t.starts_with(dir))
+        .collect()
+}
+
+#[test]
+fn writer_failing_midway_keeps_the_old_target_and_leaves_no_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mesh.glb");
+    std::fs::write(&path, b"previous complete file").unwrap();
+    let err = write_with(&path, |w| {
+        w.write_all(&[7; 100_000])?; // past the buffer: bytes reach the temporary file
+        Err(std::io::Error::other("disk full"))
+    })
+    .unwrap_err();
+    assert_eq!(err.op, "write");
+    assert!(err.to_string().contains("mesh.glb") && err.to_string().contains("disk full"));
+    assert_eq!(std::fs::read(&path).unwrap(), b"previous complete file");
+    assert_eq!(entries(dir.path()), ["mesh.glb"]);
+}
+
+#[test]
+fn missing_folder_is_a_create_error_naming_the_target() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("missing").join("out.npy");
+    let err = write_bytes(&path, b"x").unwrap_err();
+    assert_eq!((err.op, err.path.as_path()), ("create", path.as_path()));
+    assert_eq!(err.source.kind(), std::io::ErrorKind::NotFound);
+    assert!(
+        err.to_string()
+            .starts_with(&format!("cannot create {}: ", path.display())),
+        "{err}"
+    );
+    assert!(entries(dir.path()).is_empty());
+}
+
+#[test]
+fn target_that_is_a_folder_is_a_rename_error_and_the_temporary_is_removed() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("frame.png");
+    std::fs::create_dir(&path).unwrap();
+    std::fs::write(path.join("inside"), b"kept").unwrap();
+    let err = write_bytes(&path, b"png").unwrap_err();
+    assert_eq!(
+        (err.op, err.path.as_path()),
+        ("rename a temporary file onto", path.as_path())
+    );
+    assert_eq!(entries(dir.path()), ["frame.png"]);
+    assert_eq!(entries(&path), ["inside"]);
+    assert!(registered_in(dir.path()).is_empty());
+}
+
+#[test]
+fn two_threads_writing_in_one_folder_use_distinct_temporaries() {
+    let dir = tempfile::tempdir().unwrap();
+    // Both writes hold their temporary file at the same moment.
+    let barrier = Arc::new(Barrier::new(2));
+    let seen: Vec<Vec<PathBuf>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = ["a.txt", "b.txt"]
+            .into_iter()
+            .map(|name| {
+                let (barrier, dir) = (Arc::clone(&barrier), dir.path());
+                scope.spawn(move || {
+                    let mut seen = Vec::new();
+                    write_with(&dir.join(name), |w| {
+                        barrier.wait();
+                        seen = registered_in(dir);
+                        barrier.wait();
+                        w.write_all(name.repeat(1000).as_bytes())
+                    })
+                    .unwrap();
+                    seen
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for s in &seen {
+        assert_eq!(s.len(), 2, "{s:?}");
+        assert_ne!(s[0], s[1]);
+    }
+    assert_eq!(entries(dir.path()), ["a.txt", "b.txt"]);
+    for name in ["a.txt", "b.txt"] {
+        let text = std::fs::read_to_string(dir.path().join(name)).unwrap();
+        assert_eq!(text, name.repeat(1000));
+    }
+}
+
+#[test]
+fn registry_is_empty_after_success_and_after_failure() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("r.bin");
+    write_with(&path, |w| {
+        assert_eq!(registered_in(dir.path()).len(), 1);
+        w.write_all(b"ok")
+    })
+    .unwrap();
+    assert!(registered_in(dir.path()).is_empty());
+    write_with(&path, |_| Err(std::io::Error::other("fail"))).unwrap_err();
+    assert!(registered_in(dir.path()).is_empty());
+    write_via_path(&path, |_| Err("fail")).unwrap_err();
+    assert!(registered_in(dir.path()).is_empty());
+    assert_eq!(std::fs::read(&path).unwrap(), b"ok");
+}
+
+#[test]
+fn write_via_path_returns_the_closure_error_and_removes_the_temporary() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sky.exr");
+    let err = write_via_path(&path, |tmp| {
+        std::fs::write(tmp, b"half an image").map_err(|e| e.to_string())?;
+        Err("exr: unsupported sample type".to_owned())
+    })
+    .unwrap_err();
+    match err {
+        AtomicError::Writer(reason) => assert_eq!(reason, "exr: unsupported sample type"),
+        AtomicError::File(e) => panic!("expected the writer's error, got {e}"),
+    }
+    assert!(entries(dir.path()).is_empty());
+    assert!(registered_in(dir.path()).is_empty());
+}
+
+#[test]
+fn write_via_path_into_a_missing_folder_fails_before_calling_the_encoder() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("missing").join("a.png");
+    let err = write_via_path(&path, |_| -> Result<(), String> {
+        panic!("the encoder must not run without a temporary file")
+    })
+    .unwrap_err();
+    assert!(
+        matches!(&err, AtomicError::File(WriteError { op: "create", path: p, .. }) if *p == path),
+        "{err}"
+    );
+}
+
+/// Spawns this test binary running only `test` (with `env` set), stdout piped.
+fn spawn_child(test: &str, env: (&str, &std::ffi::OsStr)) -> std::process::Child {
+    Command::new(std::env::current_exe().unwrap())
+        .args(["--exact", test, "--nocapture", "--test-threads=1"])
+        .env(env.0, env.1)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits for `child` to exit, polling, for at most [`CHILD_TIMEOUT`]; kills it on timeout.
+fn wait_with_timeout(child: &mut std::process::Child) -> ExitStatus {
+    let deadline = Instant::now() + CHILD_TIMEOUT;
+    loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            return status;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("the child process did not exit within {CHILD_TIMEOUT:?}");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn sigterm_mid_write_removes_the_temporary_and_exits_130() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = spawn_child(
+        "sigterm_child_blocks_mid_write",
+        (SIGTERM_CHILD_DIR, dir.path().as_os_str()),
+    );
+    // Read the child's stdout on a thread so that waiting for its line can time out.
+    let (lines, received) = mpsc::channel();
+    let stdout = child.stdout.take().unwrap();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stdout).lines() {
+            if lines.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let deadline = Instant::now() + CHILD_TIMEOUT;
+    let temporary = loop {
+        let line = received.recv_timeout(deadline.saturating_duration_since(Instant::now()));
+        match line {
+            Ok(Ok(line)) => {
+                // libtest prints `test NAME ... ` on the same line before it.
+                if let Some((_, path)) = line.split_once("TEMPORARY ") {
+                    break PathBuf::from(path);
+                }
+            }
+            _ => {
+                let _ = child.kill();
+                panic!("the child never reported its temporary file: {line:?}");
+            }
+        }
+    };
+    assert!(temporary.exists(), "{}", temporary.display());
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let status = wait_with_timeout(&mut child);
+    assert_eq!(status.code(), Some(130), "{status}");
+    assert!(!temporary.exists(), "{} was left", temporary.display());
+    assert!(entries(dir.path()).is_empty(), "{:?}", entries(dir.path()));
+}
+
+/// The child of [`sigterm_mid_write_removes_the_temporary_and_exits_130`]; does nothing in a
+/// normal test run. Installs the handler (twice: the second call is a no-op), starts a write,
+/// reports its temporary file and blocks until the parent's SIGTERM.
+#[test]
+fn sigterm_child_blocks_mid_write() {
+    let Some(dir) = std::env::var_os(SIGTERM_CHILD_DIR).map(PathBuf::from) else {
+        return;
+    };
+    remove_temporaries_on_signal().unwrap();
+    remove_temporaries_on_signal().unwrap();
+    let result = write_with(&dir.join("interrupted.bin"), |w| {
+        w.write_all(&[1; 100_000])?;
+        w.flush()?;
+        let [temporary] = registered_temporaries().try_into().unwrap();
+        println!("TEMPORARY {}", temporary.display());
+        let deadline = Instant::now() + CHILD_TIMEOUT;
+        while Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        Err(std::io::Error::other("no signal arrived"))
+    });
+    panic!("the write returned without a signal: {result:?}");
+}
+
+#[test]
+fn a_handler_installed_by_someone_else_is_an_error_not_a_panic() {
+    let mut child = spawn_child(
+        "foreign_handler_child_installs_first",
+        (FOREIGN_HANDLER_CHILD, "1".as_ref()),
+    );
+    let status = wait_with_timeout(&mut child);
+    assert!(status.success(), "{status}");
+}
+
+/// The child of [`a_handler_installed_by_someone_else_is_an_error_not_a_panic`]; does nothing
+/// in a normal test run.
+#[test]
+fn foreign_handler_child_installs_first() {
+    if std::env::var_os(FOREIGN_HANDLER_CHILD).is_none() {
+        return;
+    }
+    ctrlc::set_handler(|| std::process::exit(1)).unwrap();
+    let err = remove_temporaries_on_signal().unwrap_err();
+    assert!(err.to_string().contains("registered_temporaries"), "{err}");
+    assert!(std::error::Error::source(&err).is_some());
+}
