@@ -1,4 +1,6 @@
-//! The project's shared equirectangular (lat-long) convention, identical in `lightsphere`:
+//! The project's shared equirectangular (lat-long) convention, identical in `lightsphere`
+//! (kept dependency-free here; the workspace test `tests/latlong.rs` checks that both agree
+//! texel for texel, and render's backdrop shader states the same convention):
 //!
 //! World is +Y up. In an image of `width` W × `height` H, row r (0 = top) covers polar
 //! angle θ ∈ [π r/H, π (r+1)/H] measured from +Y; column c covers azimuth
@@ -76,18 +78,31 @@ pub fn texel_direction(row: usize, col: usize, width: usize, height: usize) -> D
 pub fn texel_solid_angle(row: usize, width: usize, height: usize) -> f64 {
     let top = PI * row as f64 / height as f64;
     let bottom = PI * (row + 1) as f64 / height as f64;
-    TAU / width as f64 * (top.cos() - bottom.cos())
+    // cos θ_top − cos θ_bottom as 2·sin(mean)·sin(half difference), as lightsphere: thin rows
+    // near the poles keep their digits.
+    let (mean, half) = (0.5 * (top + bottom), 0.5 * (bottom - top));
+    TAU / width as f64 * 2.0 * mean.sin() * half.sin()
 }
 
 /// The texel (`row`, `col`) whose area contains direction `dir` (need not be normalised),
 /// or `None` for a zero or non-finite `dir`. Boundaries belong to the texel below / to the
 /// right, the poles to the first and last row, φ = 2π wraps to column 0.
 pub fn texel_containing(dir: DVec3, width: usize, height: usize) -> Option<(usize, usize)> {
-    let d = dir.try_normalize()?;
-    let theta = d.y.clamp(-1.0, 1.0).acos();
-    let phi = d.z.atan2(d.x).rem_euclid(TAU);
-    let row = ((theta / PI * height as f64) as usize).min(height.saturating_sub(1));
-    let col = ((phi / TAU * width as f64) as usize) % width.max(1);
+    if !dir.is_finite() || dir == DVec3::ZERO {
+        return None;
+    }
+    // The same arithmetic as lightsphere, so both agree on boundaries: atan2 of (horizontal
+    // length, y) is accurate near the poles, unlike acos; −tiny + 2π rounding to 2π is φ = 0.
+    let theta = dir.x.hypot(dir.z).atan2(dir.y);
+    let mut phi = dir.z.atan2(dir.x);
+    if phi < 0.0 {
+        phi += TAU;
+    }
+    if phi >= TAU {
+        phi = 0.0;
+    }
+    let row = ((theta / PI * height as f64).floor() as usize).min(height.saturating_sub(1));
+    let col = ((phi / TAU * width as f64).floor() as usize).min(width.saturating_sub(1));
     Some((row, col))
 }
 
