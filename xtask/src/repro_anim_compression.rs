@@ -26,7 +26,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anim_pca::compress::{Compressed, CpcaModel, CpcaParams, Decoder, distortion};
-use cloth_vis::plot::{Axis, Series, chart_svg, log_log_svg};
+use figures::chart::{Axis, Series, chart_svg, log_log_svg};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -385,8 +385,22 @@ fn cluster_picture(
     )?;
     let name = format!("anim-compression-clusters-{}.png", s.slug());
     let path = out.join(&name);
-    let image = cloth_vis::anim_compress_cmd::cluster_strip(gpu, &packed, &path)?;
-    cloth_vis::strip::write_png(&path, &image)?;
+    // The clusters on the decoded clip, as `cloth-vis anim stats --clusters-png` draws them.
+    let frames = anim_pca::compress::Decoder::new(&packed).decode_all();
+    let albedo = figures::strip::label_albedo(packed.labels(), packed.clusters());
+    let image = figures::strip::render_strip(
+        &gpu.device,
+        &gpu.queue,
+        &frames,
+        packed.triangles(),
+        &figures::strip::StripOptions {
+            count: figures::strip::DEFAULT_STRIP_FRAMES.min(frames.len()),
+            panel_size: figures::strip::DEFAULT_PANEL_SIZE,
+            albedo: Some(&albedo),
+        },
+        &path,
+    )?;
+    figures::strip::write_png(&path, &image)?;
     Ok(name)
 }
 

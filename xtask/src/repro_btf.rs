@@ -31,7 +31,7 @@ use btf::{
     BtfDir, BtfPca, BtfPcaParams, DIRECTIONS, Sampling, SlotPca, Storage, ViewSlot, linear_to_srgb,
     write_btf_view,
 };
-use cloth_vis::plot::{Axis, Series, chart_svg};
+use figures::chart::{Axis, Series, chart_svg};
 use synth::{WovenBtf, WovenBtfParams};
 
 /// Resolution of the full-size timing (the thesis's and the 256²).

@@ -34,7 +34,7 @@ use rayon::prelude::*;
 
 use crate::repro_visibility::cpu_model;
 use crate::sequences::{Sequence, load_sequences};
-use cloth_vis::plot::{Series, log_log_svg};
+use figures::chart::{Series, log_log_svg};
 
 /// Longest clip analysed; longer ones are cut to their first frames (8 s at 30 fps).
 const MAX_CLIP_FRAMES: usize = 240;
@@ -227,19 +227,19 @@ fn strip(
     }
     let name = format!("jumpmap-{}.png", sequence.slug());
     let path = out.join(&name);
-    let image = cloth_vis::strip::render_strip(
+    let image = figures::strip::render_strip(
         &gpu.device,
         &gpu.queue,
         &frames,
         &sequence.triangles,
-        &cloth_vis::strip::StripOptions {
+        &figures::strip::StripOptions {
             count: STRIP_PANELS,
             panel_size: STRIP_PANEL,
             albedo: None,
         },
         &path,
     )?;
-    cloth_vis::strip::write_png(&path, &image)?;
+    figures::strip::write_png(&path, &image)?;
     Ok(name)
 }
 
@@ -620,7 +620,7 @@ fn report(
                 md,
                 "{STRIP_PANELS} evenly spaced frames (first to last) of a {STRIP_RUN_FRAMES}-frame \
                  run with the defaults, seed {SEED}, one camera framing the whole run \
-                 (`cloth_vis::strip::render_strip`, as `cloth-vis anim jumpmap --strip`).\n"
+                 (`figures::strip::render_strip`, as `cloth-vis anim jumpmap --strip`).\n"
             );
             for (s, m) in results {
                 if let Some(file) = &m.strip {

@@ -16,7 +16,7 @@ use glam::{DVec3, Vec3};
 use lightsphere::{Environment, Lightsphere, RadianceMethod};
 use rayon::prelude::*;
 
-use cloth_vis::plot::{Series, log_log_svg};
+use figures::chart::{Series, log_log_svg};
 
 /// Normals on a Fibonacci sphere.
 fn normals(count: usize) -> Vec<DVec3> {

@@ -23,7 +23,7 @@ use anyhow::Context as _;
 use lightsphere::Lightsphere;
 use occlusion_gpu::{Backend, DepthParams, Scene, VisibilityEngine, VisibilityParams};
 
-use cloth_vis::plot::{Series, log_log_svg};
+use figures::chart::{Series, log_log_svg};
 
 /// A measurement whose first run is shorter than this is repeated twice more and the median
 /// of the three runs is reported; longer ones are run once.

@@ -124,14 +124,14 @@ fn bench(c: &mut Criterion) {
     // 12 panels of 256², the cloth animation.
     let mut group = c.benchmark_group("strip_12_panels");
     group.sample_size(10);
-    let options = cloth_vis::strip::StripOptions {
+    let options = figures::strip::StripOptions {
         count: 12,
         panel_size: [256, 256],
         albedo: None,
     };
     group.bench_function("renderer_built_once", |b| {
         b.iter(|| {
-            cloth_vis::strip::render_strip(
+            figures::strip::render_strip(
                 &gpu.device,
                 &gpu.queue,
                 &anim.frames,

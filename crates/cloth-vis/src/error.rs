@@ -62,6 +62,9 @@ pub enum Error {
     /// GPU acquisition, rendering or image output failed.
     #[error(transparent)]
     Gpu(#[from] gpu_context::GpuError),
+    /// A chart or strip could not be drawn or written.
+    #[error(transparent)]
+    Figure(#[from] figures::FigureError),
     /// The renderer refused a frame (camera, mesh, target).
     #[error(transparent)]
     Render(#[from] render::RenderError),
@@ -82,5 +85,14 @@ pub enum Error {
 impl From<btf::BtfError> for Error {
     fn from(e: btf::BtfError) -> Self {
         Self::Btf(Box::new(e))
+    }
+}
+
+impl From<atomic_out::WriteError> for Error {
+    fn from(e: atomic_out::WriteError) -> Self {
+        Self::Io {
+            reason: format!("cannot {} it: {}", e.op, e.source),
+            path: e.path,
+        }
     }
 }

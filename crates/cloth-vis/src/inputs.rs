@@ -5,7 +5,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 use serde_json::json;
 
 use crate::Error;
@@ -26,7 +26,16 @@ fn cloth_params(scene: &Scene) -> synth::ClothParams {
     params
 }
 
-pub(crate) fn load_geometry(
+/// Load every object of `scene` in world space: files through `meshio`, the simulated cloth
+/// (simulated once, shared by every object that shows it, with a progress bar when
+/// `progress`), the obstacle; posed at each object's `frame`, with angle-weighted normals
+/// computed in world space and, for animated sources, every frame kept for sequences.
+/// Returns the objects and what the run report records of each.
+///
+/// # Errors
+/// Loader errors naming the file, [`Error::Frame`] for a frame outside an animation,
+/// [`Error::Scene`] for a source the scene cannot resolve.
+pub fn load_geometry(
     scene: &Scene,
     progress: bool,
 ) -> Result<(Vec<WorldObject>, serde_json::Value), Error> {
@@ -199,7 +208,13 @@ fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, E
     Ok((mesh.positions, mesh.triangles, mesh.uvs, detail, None))
 }
 
-pub(crate) fn load_environment(
+/// Load or make the scene's HDR environment (a file, or the procedural sky), rotated about
+/// +Y by `[environment] rotation_deg` and prefiltered when asked. Returns the environment and
+/// what the run report records of it.
+///
+/// # Errors
+/// Loader errors naming the file; [`Error::Scene`] when the scene has no environment.
+pub fn load_environment(
     scene: &Scene,
 ) -> Result<(lightsphere::Environment, serde_json::Value), Error> {
     let desc = scene.environment.as_ref().ok_or_else(|| Error::Scene {
@@ -225,7 +240,7 @@ pub(crate) fn load_environment(
             });
         }
     };
-    let rotation = Quat::from_rotation_y(desc.rotation_deg.to_radians());
+    let rotation = crate::lighting::environment_rotation(desc.rotation_deg);
     let mut env = env.with_rotation(rotation);
     if desc.prefilter_sigma_deg > 0.0 {
         env = env.prefiltered(desc.prefilter_sigma_deg)?;
@@ -257,7 +272,13 @@ fn sky_params(scene: &Scene) -> synth::SkyParams {
     params
 }
 
-pub(crate) fn light_directions(
+/// The lightsphere of `[lighting] level` and the radiance I_j of `env` per direction (paper
+/// 000 §3.4, by the scene's method), with the relative error of the total power Σ_j I_j ω_j
+/// against the environment's for the run report.
+///
+/// # Errors
+/// [`Error::Light`] for a level outside the lightsphere's range.
+pub fn light_directions(
     scene: &Scene,
     env: &lightsphere::Environment,
 ) -> Result<((lightsphere::Lightsphere, Vec<Vec3>), serde_json::Value), Error> {

@@ -1,9 +1,13 @@
 //! # cloth-vis
 //!
 //! The facade of the cloth-vis workspace: scene files, the effect graph that builds only the
-//! stages a scene asks for, file input through `meshio`, the CLI
-//! (`cloth-vis render SCENE.toml --out DIR [--frames A..B]`, `cloth-vis demo --out DIR`,
-//! `cloth-vis inspect`, …) and the demo. It draws through the shared frame of crate `render`
+//! stages a scene asks for, the stages themselves (geometry, environment, light directions,
+//! visibility, lighting, render, BTF), file input through `meshio`, and the demo. The
+//! `cloth-vis` binary (`cloth-vis render SCENE.toml --out DIR [--frames A..B]`,
+//! `cloth-vis demo --out DIR`, `cloth-vis visibility`, `cloth-vis inspect`, …) is a thin
+//! layer over this library: its subcommands live in the binary's `commands/` folder and are
+//! not library API; `cloth-vis visibility` runs a one-object scene through the same stages.
+//! It draws through the shared frame of crate `render`
 //! (one renderer per run, reused for every frame of a sequence) and holds no renderer itself.
 //!
 //! It implements the lighting side of paper 000 (thesis §4.4): per-vertex colours
@@ -34,25 +38,19 @@
 //! # Ok::<(), cloth_vis::Error>(())
 //! ```
 
-pub mod anim_cmd;
-pub mod anim_compress_cmd;
-pub mod btf_cmd;
 pub mod btf_stage;
 pub mod camera;
 pub mod demo;
 pub mod effects;
 mod error;
-mod inputs;
+pub mod inputs;
 pub mod lighting;
 pub mod object;
 pub mod plan;
-pub mod plot;
 pub mod report;
 pub mod run;
 pub mod scene;
 pub mod shadowing;
-pub mod strip;
-pub mod visibility_cmd;
 
 pub use demo::{DEMO_SCENE, demo_scene, run_demo};
 pub use effects::Effect;

@@ -10,9 +10,66 @@
 //!
 //! Accumulation is in f64: at level 6 a vertex sums 16,386 terms spanning the sun (10⁴× the
 //! mean sky) and faint sky directions.
+//!
+//! This module is the one home of the formula: [`lambertian_radiance`] without visibility,
+//! [`shadowed_radiance`] with the visibility matrix M (used by the `self-shadowing` stage and
+//! by `cloth-vis visibility`), and the environment rotation both share
+//! ([`environment_rotation`], [`rotated_lookup_radiance`]).
 
-use glam::{DVec3, Vec3};
+use glam::{DQuat, DVec3, Quat, Vec3};
 use rayon::prelude::*;
+
+use crate::Error;
+
+/// Vertex radiance of a white Lambertian surface with visibility:
+/// c_i = (1/π) Σ_j M_ij I_j ω_j for every row i of `m` (multiply by the albedo ρ for a
+/// coloured surface). Rows of vertices used by no face are NaN. The sum runs in the
+/// visibility engine's f64 accumulation over `sphere.light_weights(radiance)` = I_j ω_j.
+///
+/// # Errors
+/// [`Error::Light`] when `radiance` does not hold one value per direction of `sphere`, or
+/// [`Error::Visibility`] when `m` was computed for another direction count.
+pub fn shadowed_radiance(
+    m: &occlusion_gpu::VisibilityMatrix,
+    sphere: &lightsphere::Lightsphere,
+    radiance: &[Vec3],
+) -> Result<Vec<Vec3>, Error> {
+    let weights = sphere.light_weights(radiance)?;
+    Ok(m.radiance(&weights)?
+        .into_iter()
+        .map(|c| c / std::f32::consts::PI)
+        .collect())
+}
+
+/// `world_from_rotated_env`: the rotation by `deg` degrees about +Y (right-handed), built in
+/// f64 so that quarter turns map the octahedral directions onto each other to f64 rounding.
+/// Scenes' `[environment] rotation_deg` and `cloth-vis visibility --env-rotation` use it.
+pub fn environment_rotation(deg: f32) -> Quat {
+    DQuat::from_rotation_y(f64::from(deg).to_radians()).as_quat()
+}
+
+/// Radiance per light direction I_j of `env` turned by `deg` about +Y relative to the object
+/// (on top of its own `world_from_env`), by rotated look-ups (thesis §4.4.5: "the light
+/// directions are multiplied by the same rotation matrix to obtain the new look-up
+/// positions"): I_j is the environment's cell mean around R⁻¹·l_j. M, indexed by the
+/// unrotated l_j, is reused as is — this is how a viewer turns the light without recomputing
+/// visibility. Equals `env.with_rotation(environment_rotation(deg) * env.world_from_env())`
+/// sampled at the l_j, up to rounding (tested).
+///
+/// # Errors
+/// [`Error::Light`] for a non-finite angle.
+pub fn rotated_lookup_radiance(
+    env: &lightsphere::Environment,
+    sphere: &lightsphere::Lightsphere,
+    deg: f32,
+) -> Result<Vec<Vec3>, Error> {
+    let lookup = if deg == 0.0 {
+        sphere.clone()
+    } else {
+        sphere.try_rotated(environment_rotation(deg).inverse())?
+    };
+    Ok(env.radiance_per_direction(&lookup, lightsphere::RadianceMethod::CellMean)?)
+}
 
 /// Outgoing Lambertian radiance per vertex: c_i = (ρ/π) Σ_j max(0, n_i·l_j) I_j ω_j.
 ///

@@ -73,6 +73,18 @@ impl WorldObject {
         true
     }
 
+    /// Indices of the vertices some triangle uses, ascending (out-of-range indices, which
+    /// the loaders refuse, are ignored).
+    pub fn used_vertices(&self) -> Vec<usize> {
+        let mut used = vec![false; self.positions.len()];
+        for &i in self.triangles.iter().flatten() {
+            if let Some(u) = used.get_mut(i as usize) {
+                *u = true;
+            }
+        }
+        (0..used.len()).filter(|&i| used[i]).collect()
+    }
+
     /// The world positions of every frame (for framing a camera over a whole sequence).
     pub fn all_world_positions(&self) -> Vec<Vec3> {
         match &self.animation {

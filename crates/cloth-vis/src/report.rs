@@ -108,8 +108,5 @@ fn compact(v: &serde_json::Value) -> String {
 /// # Errors
 /// [`Error::Io`] naming `path` and the step that failed; no partial file is left behind.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), Error> {
-    atomic_out::write_bytes(path, bytes).map_err(|e| Error::Io {
-        path: e.path,
-        reason: format!("cannot {} it: {}", e.op, e.source),
-    })
+    Ok(atomic_out::write_bytes(path, bytes)?)
 }

@@ -19,6 +19,7 @@ use crate::object::WorldObject;
 use crate::plan::{Plan, Stage};
 use crate::report::{RunReport, StageRecord};
 use crate::scene::{BackgroundDesc, BackgroundKeyword, ExposureDesc, GROUND_NAME, Scene, ToneDesc};
+use crate::shadowing::VisibilityStage;
 
 /// How a scene is run.
 #[derive(Clone, Debug, Default)]
@@ -150,20 +151,13 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         None
     };
 
-    let format = FrameFormat::for_context(&gpu);
-    let mut renderer = Renderer::new(&gpu.device, format);
-    let background = background(scene, environment.is_some());
-    if background == Background::Environment {
-        renderer.backdrop.set_environment(
-            &gpu.device,
-            environment.as_ref().map(|env| render::Backdrop {
-                width: env.width(),
-                height: env.height(),
-                texels: env.texels(),
-                world_from_env: env.world_from_env(),
-            }),
-        );
-    }
+    let (mut renderer, background, format) = renderer_for(scene, &gpu, environment.as_ref());
+    // One engine for the whole run: GPU backends keep their pipelines across frames.
+    let mut shadowing = if plan.contains(Stage::Visibility) {
+        Some(VisibilityStage::new(scene, Some(&gpu))?)
+    } else {
+        None
+    };
     let look = Look {
         camera,
         background,
@@ -175,7 +169,7 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
     let image = match frames {
         None => {
             if let Some(lights) = &lights {
-                light_frame(scene, &plan, &gpu, &mut objects, lights, &mut timer)?;
+                light_frame(shadowing.as_mut(), &mut objects, lights, &mut timer)?;
             }
             timer.run(Stage::Render, || {
                 let (image, params, written) =
@@ -189,7 +183,7 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                 scene,
                 out_dir,
                 &gpu,
-                &plan,
+                shadowing.as_mut(),
                 &mut renderer,
                 &mut objects,
                 lights.as_ref(),
@@ -257,23 +251,25 @@ fn background(scene: &Scene, has_environment: bool) -> Background {
     }
 }
 
-/// The scene's camera: framed on the objects' bounding sphere (over every frame of `range`
-/// for a sequence, so the camera holds still).
+/// The scene's camera: framed on the bounding sphere of the vertices the objects' triangles
+/// use (a stray unreferenced vertex does not shrink the picture), over every frame of `range`
+/// for a sequence, so the camera holds still.
 fn frame_camera(scene: &Scene, objects: &[WorldObject], range: Option<FrameRange>) -> Camera {
-    let points: Vec<Vec3> = match range {
-        None => objects.iter().flat_map(|o| o.positions.clone()).collect(),
-        Some(r) => objects
-            .iter()
-            .flat_map(|o| match &o.animation {
-                None => o.positions.clone(),
-                Some(a) => a.frames[r.start..r.end]
-                    .iter()
-                    .flatten()
-                    .map(|p| a.world_from_object.transform_point3(*p))
-                    .collect(),
-            })
-            .collect(),
-    };
+    let mut points = Vec::new();
+    for o in objects {
+        let used = o.used_vertices();
+        match (&o.animation, range) {
+            (Some(a), Some(r)) => {
+                for frame in &a.frames[r.start..r.end] {
+                    points.extend(
+                        used.iter()
+                            .map(|&i| a.world_from_object.transform_point3(frame[i])),
+                    );
+                }
+            }
+            _ => points.extend(used.iter().map(|&i| o.positions[i])),
+        }
+    }
     let (centre, radius) = bounding_sphere(&points).unwrap_or((Vec3::ZERO, 1.0));
     crate::camera::resolve(&scene.camera, centre, radius)
 }
@@ -338,19 +334,14 @@ type Lights = (lightsphere::Lightsphere, Vec<Vec3>);
 
 /// Visibility (when planned) and lighting of the objects as posed, recorded as stages.
 fn light_frame(
-    scene: &Scene,
-    plan: &Plan,
-    gpu: &GpuContext,
+    shadowing: Option<&mut VisibilityStage>,
     objects: &mut [WorldObject],
     (sphere, radiance): &Lights,
     timer: &mut Timer,
 ) -> Result<(), Error> {
-    let visibility = if plan.contains(Stage::Visibility) {
-        Some(timer.run(Stage::Visibility, || {
-            crate::shadowing::visibility(scene, gpu, objects, sphere)
-        })?)
-    } else {
-        None
+    let visibility = match shadowing {
+        Some(stage) => Some(timer.run(Stage::Visibility, || stage.compute(objects, sphere))?),
+        None => None,
     };
     timer.run(Stage::Lighting, || {
         let vertices =
@@ -364,8 +355,54 @@ fn light_frame(
     })
 }
 
+/// A renderer for `scene`: its frame format, the environment backdrop when the background
+/// shows it, and the background itself.
+fn renderer_for(
+    scene: &Scene,
+    gpu: &GpuContext,
+    environment: Option<&lightsphere::Environment>,
+) -> (Renderer, Background, FrameFormat) {
+    let format = FrameFormat::for_context(gpu);
+    let mut renderer = Renderer::new(&gpu.device, format);
+    let background = background(scene, environment.is_some());
+    if background == Background::Environment {
+        renderer.backdrop.set_environment(
+            &gpu.device,
+            environment.map(|env| render::Backdrop {
+                width: env.width(),
+                height: env.height(),
+                texels: env.texels(),
+                world_from_env: env.world_from_env(),
+            }),
+        );
+    }
+    (renderer, background, format)
+}
+
+/// One still of `objects` as they are lit (preview shading where unlit) through the scene's
+/// camera framed on them, over its background, with its display mapping — what
+/// [`run_scene`] draws and writes, for callers that run the stages themselves (`cloth-vis
+/// visibility --render`). Returns the linear image, the display mapping for a PNG and the
+/// background (for the alpha matte).
+///
+/// # Errors
+/// [`Error::Render`] when the renderer refuses the meshes or the camera.
+pub fn render_still_image(
+    scene: &Scene,
+    gpu: &GpuContext,
+    objects: &[WorldObject],
+    environment: Option<&lightsphere::Environment>,
+) -> Result<(HdrImage, Display, Background), Error> {
+    let (mut renderer, background, _) = renderer_for(scene, gpu, environment);
+    let camera = frame_camera(scene, objects, None);
+    set_gouraud_meshes(gpu, &mut renderer, objects, &camera, &[])?;
+    let image = renderer.render(&gpu.device, &gpu.queue, &camera, background, &[])?;
+    let display = display_for(scene, &image);
+    Ok((image, display, background))
+}
+
 /// A progress bar on stderr labelled `message`, hidden when `show` is false.
-pub(crate) fn progress_bar(show: bool, len: u64, message: &'static str) -> ProgressBar {
+pub fn progress_bar(show: bool, len: u64, message: &'static str) -> ProgressBar {
     if !show {
         return ProgressBar::hidden();
     }
@@ -504,7 +541,7 @@ fn render_sequence(
     scene: &Scene,
     out_dir: &Path,
     gpu: &GpuContext,
-    plan: &Plan,
+    mut shadowing: Option<&mut VisibilityStage>,
     renderer: &mut Renderer,
     objects: &mut [WorldObject],
     lights: Option<&Lights>,
@@ -526,9 +563,9 @@ fn render_sequence(
         }
         FrameTimes::add(&mut pose_t, ms_since(t));
         if let Some((sphere, radiance)) = lights {
-            let visibility = if plan.contains(Stage::Visibility) {
+            let visibility = if let Some(stage) = shadowing.as_deref_mut() {
                 let t = Instant::now();
-                let (v, p) = crate::shadowing::visibility(scene, gpu, objects, sphere)?;
+                let (v, p) = stage.compute(objects, sphere)?;
                 FrameTimes::add(&mut vis_t, ms_since(t));
                 vis_params = p;
                 Some(v)

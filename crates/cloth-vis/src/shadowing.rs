@@ -24,65 +24,133 @@ pub struct Visibility {
     rows: Vec<(std::ops::Range<usize>, Option<std::ops::Range<usize>>)>,
 }
 
-/// Compute M for all objects, each object occluding all others.
+impl Visibility {
+    /// The matrix: one row per receiver vertex (front rows, then back rows of two-sided
+    /// objects, in object order), one column per light direction.
+    pub fn matrix(&self) -> &VisibilityMatrix {
+        &self.matrix
+    }
+
+    /// The rows of object `index`'s front side, and of its back side when two-sided.
+    pub fn rows(
+        &self,
+        index: usize,
+    ) -> Option<&(std::ops::Range<usize>, Option<std::ops::Range<usize>>)> {
+        self.rows.get(index)
+    }
+}
+
+/// The visibility stage of a run: the engine of the scene's backend, built once and reused
+/// for every frame of a sequence (GPU backends keep their pipelines and buffers).
+pub struct VisibilityStage {
+    engine: VisibilityEngine,
+    backend: Backend,
+    depth_resolution: u32,
+}
+
+impl VisibilityStage {
+    /// The engine for `[visibility]` of `scene`: `auto` is the depth backend on a hardware
+    /// adapter and the exact CPU ray caster on a software one or without one.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] when the scene asks for a GPU backend and `gpu` is `None`.
+    pub fn new(scene: &Scene, gpu: Option<&GpuContext>) -> Result<Self, Error> {
+        let backend = match (scene.visibility.backend, gpu) {
+            (VisibilityBackendDesc::Cpu, _) => Backend::Cpu,
+            (VisibilityBackendDesc::Depth, _) => Backend::Depth,
+            (VisibilityBackendDesc::Query, _) => Backend::Query,
+            (VisibilityBackendDesc::Auto, Some(g)) if !g.summary().is_software => Backend::Depth,
+            (VisibilityBackendDesc::Auto, _) => Backend::Cpu,
+        };
+        let depth_resolution = scene.visibility.depth_resolution;
+        let params = VisibilityParams::default()
+            .with_depth(DepthParams::default().with_resolution(depth_resolution));
+        let engine = match (backend, gpu) {
+            (Backend::Cpu, _) => VisibilityEngine::cpu(params),
+            (other, Some(g)) => VisibilityEngine::with_gpu(&g.device, &g.queue, other, params),
+            (other, None) => {
+                return Err(Error::Scene {
+                    origin: scene.origin.clone(),
+                    message: format!(
+                        "visibility backend {} needs a GPU adapter and none was found; use \
+                         the cpu backend (--backend cpu, or backend = \"cpu\" in [visibility])",
+                        other.name()
+                    ),
+                });
+            }
+        };
+        Ok(Self {
+            engine,
+            backend,
+            depth_resolution,
+        })
+    }
+
+    /// The backend that runs.
+    pub fn backend(&self) -> Backend {
+        self.backend
+    }
+
+    /// M for all objects as posed, each object occluding all others; two-sided objects get a
+    /// second set of rows with flipped normals. Returns M and what the run report records.
+    ///
+    /// # Errors
+    /// [`Error::Visibility`] when the engine rejects the scene or the GPU fails.
+    pub fn compute(
+        &mut self,
+        objects: &[WorldObject],
+        sphere: &lightsphere::Lightsphere,
+    ) -> Result<(Visibility, serde_json::Value), Error> {
+        let mut occ = occlusion_gpu::Scene::new();
+        let mut indices = Vec::with_capacity(objects.len());
+        for object in objects {
+            let front = occ.push(SceneObject::new(
+                object.positions.clone(),
+                object.normals.clone(),
+                object.triangles.clone(),
+            ))?;
+            let back = if object.two_sided {
+                let flipped: Vec<Vec3> = object.normals.iter().map(|n| -*n).collect();
+                let copy =
+                    SceneObject::new(object.positions.clone(), flipped, object.triangles.clone());
+                Some(occ.push(copy)?)
+            } else {
+                None
+            };
+            indices.push((front, back));
+        }
+        let matrix = self.engine.compute(&occ, sphere)?;
+        let rows = indices
+            .iter()
+            .map(|(front, back)| {
+                let f = occ.receiver_rows(*front).unwrap_or(0..0);
+                (f, back.and_then(|b| occ.receiver_rows(b)))
+            })
+            .collect();
+        let total = matrix.rows() * matrix.directions_len();
+        let report = json!({
+            "backend": self.backend.name(),
+            "rows": matrix.rows(),
+            "directions": matrix.directions_len(),
+            "visible_share": matrix.visible_count() as f64 / total.max(1) as f64,
+            "rays": self.engine.last_ray_count(),
+            "depth_resolution": self.depth_resolution,
+        });
+        Ok((Visibility { matrix, rows }, report))
+    }
+}
+
+/// Compute M for all objects once ([`VisibilityStage`] built and used for one frame).
 ///
 /// # Errors
-/// [`Error::Visibility`] when the engine rejects the scene or the GPU fails.
+/// As [`VisibilityStage::new`] and [`VisibilityStage::compute`].
 pub fn visibility(
     scene: &Scene,
     gpu: &GpuContext,
     objects: &[WorldObject],
     sphere: &lightsphere::Lightsphere,
 ) -> Result<(Visibility, serde_json::Value), Error> {
-    let mut occ = occlusion_gpu::Scene::new();
-    let mut indices = Vec::with_capacity(objects.len());
-    for object in objects {
-        let front = occ.push(SceneObject::new(
-            object.positions.clone(),
-            object.normals.clone(),
-            object.triangles.clone(),
-        ))?;
-        let back = if object.two_sided {
-            let flipped: Vec<Vec3> = object.normals.iter().map(|n| -*n).collect();
-            let copy =
-                SceneObject::new(object.positions.clone(), flipped, object.triangles.clone());
-            Some(occ.push(copy)?)
-        } else {
-            None
-        };
-        indices.push((front, back));
-    }
-    let backend = match scene.visibility.backend {
-        VisibilityBackendDesc::Cpu => Backend::Cpu,
-        VisibilityBackendDesc::Depth => Backend::Depth,
-        VisibilityBackendDesc::Query => Backend::Query,
-        VisibilityBackendDesc::Auto if gpu.summary().is_software => Backend::Cpu,
-        VisibilityBackendDesc::Auto => Backend::Depth,
-    };
-    let params = VisibilityParams::default()
-        .with_depth(DepthParams::default().with_resolution(scene.visibility.depth_resolution));
-    let mut engine = match backend {
-        Backend::Cpu => VisibilityEngine::cpu(params),
-        other => VisibilityEngine::with_gpu(&gpu.device, &gpu.queue, other, params),
-    };
-    let matrix = engine.compute(&occ, sphere)?;
-    let rows = indices
-        .iter()
-        .map(|(front, back)| {
-            let f = occ.receiver_rows(*front).unwrap_or(0..0);
-            (f, back.and_then(|b| occ.receiver_rows(b)))
-        })
-        .collect();
-    let total = matrix.rows() * matrix.directions_len();
-    let report = json!({
-        "backend": backend.name(),
-        "rows": matrix.rows(),
-        "directions": matrix.directions_len(),
-        "visible_share": matrix.visible_count() as f64 / total.max(1) as f64,
-        "rays": engine.last_ray_count(),
-        "depth_resolution": scene.visibility.depth_resolution,
-    });
-    Ok((Visibility { matrix, rows }, report))
+    VisibilityStage::new(scene, Some(gpu))?.compute(objects, sphere)
 }
 
 /// Light every object: with M when `visibility` is given, else with M_ij = max(0, n_i·l_j).
@@ -100,11 +168,10 @@ pub fn light_objects(
     let mut vertices = 0;
     match visibility {
         Some(vis) => {
-            // I_j ω_j, then c = ρ/π Σ_j M_ij (I_j ω_j).
-            let weights = sphere.light_weights(radiance)?;
-            let c = vis.matrix.radiance(&weights)?;
+            // c = ρ · (1/π) Σ_j M_ij I_j ω_j.
+            let c = crate::lighting::shadowed_radiance(&vis.matrix, sphere, radiance)?;
             for (object, (front, back)) in objects.iter_mut().zip(&vis.rows) {
-                let scale = object.albedo / std::f32::consts::PI;
+                let scale = object.albedo;
                 let take = |range: &std::ops::Range<usize>| -> Vec<Vec3> {
                     c[range.clone()]
                         .iter()

@@ -26,6 +26,9 @@ const PALETTE: [&str; 12] = [
     "#bcbd22", "#7f7f7f", "#393b79", "#ad494a",
 ];
 
+/// Most ticks on one axis (about; see `Scale::ticks`).
+const MAX_TICKS: usize = 12;
+
 /// A series with more points than this is drawn as a line without dots.
 const MAX_DOTS: usize = 60;
 
@@ -80,18 +83,33 @@ impl Scale {
             Axis::Linear => v,
             Axis::Log => v.log10(),
         };
-        (t - self.lo) / (self.hi - self.lo)
+        // Halved so that an axis spanning ±f64::MAX does not overflow to ∞ (and NaN).
+        (0.5 * t - 0.5 * self.lo) / (0.5 * self.hi - 0.5 * self.lo)
     }
 
+    /// At most about [`MAX_TICKS`] ticks: decades thinned to every n-th power of ten on a
+    /// wide log axis; on a linear axis whose span overflows f64 only the two ends.
     fn ticks(&self) -> Vec<(f64, String)> {
         match self.axis {
-            Axis::Log => ((self.lo as i32)..=(self.hi as i32))
-                .map(|e| (10f64.powi(e), format!("1e{e}")))
-                .collect(),
+            Axis::Log => {
+                let (lo, hi) = (self.lo as i32, self.hi as i32);
+                let stride = ((hi - lo) as usize).div_ceil(MAX_TICKS).max(1);
+                (lo..=hi)
+                    .step_by(stride)
+                    .map(|e| (10f64.powi(e), format!("1e{e}")))
+                    .collect()
+            }
             Axis::Linear => {
-                let step = nice_step(self.hi - self.lo);
-                let n = ((self.hi - self.lo) / step).round() as i64;
-                (0..=n)
+                let span = self.hi - self.lo;
+                let step = nice_step(span);
+                let n = span / step;
+                if !(n.is_finite() && n <= 2.0 * MAX_TICKS as f64) {
+                    return [self.lo, self.hi]
+                        .into_iter()
+                        .map(|v| (v, format!("{v:e}")))
+                        .collect();
+                }
+                (0..=n.round() as i64)
                     .map(|i| {
                         let v = self.lo + i as f64 * step;
                         (v, format!("{}", (v * 1e6).round() / 1e6))
@@ -116,9 +134,27 @@ fn nice_step(span: f64) -> f64 {
         .unwrap_or(10.0 * p)
 }
 
+/// `text` with the five XML special characters escaped, so that a label such as `d_f < 1%`
+/// or `R&D` keeps the SVG well-formed.
+fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '&' => out.push_str("&amp;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            other => out.push(other),
+        }
+    }
+    out
+}
+
 /// Renders `series` as an SVG chart with the given axes (`labels` and `axes` are x then y).
 pub fn chart_svg(title: &str, labels: [&str; 2], axes: [Axis; 2], series: &[Series]) -> String {
-    let [x_label, y_label] = labels;
+    let title = escape(title);
+    let [x_label, y_label] = labels.map(escape);
     let (w, h, left, right, top, bottom) = (760.0, 480.0, 80.0, 220.0, 40.0, 60.0);
     let xs = Scale::fit(
         axes[0],
@@ -191,7 +227,7 @@ pub fn chart_svg(title: &str, labels: [&str; 2], axes: [Axis; 2], series: &[Seri
             w - right + 30.0,
             w - right + 36.0,
             ly + 4.0,
-            s.label
+            escape(&s.label)
         );
     }
     svg.push_str("</svg>\n");

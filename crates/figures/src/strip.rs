@@ -9,15 +9,13 @@
 //! triangles of each frame (the clips carry none). The panels are tone-mapped with gamma 2.2
 //! and copied into one RGBA8 image.
 
-use std::io::Write as _;
 use std::path::Path;
 
 use glam::Vec3;
 use render::tone::{Display, ToneCurve};
-use render::{Background, DrawMesh, FrameFormat, Renderer, bounding_sphere};
+use render::{Background, Camera, DrawMesh, FrameFormat, Renderer, bounding_sphere};
 
-use crate::Error;
-use crate::scene::CameraDesc;
+use crate::FigureError as Error;
 
 /// Panels in a strip when not given (`--strip-frames`).
 pub const DEFAULT_STRIP_FRAMES: usize = 8;
@@ -29,7 +27,7 @@ pub const DEFAULT_PANEL_SIZE: [u32; 2] = [256, 256];
 pub const MAX_PANEL_SIDE: u32 = 8192;
 
 /// Direction towards the key light, world space (normalised on use): above and in front,
-/// from the side of the default camera (`CameraDesc::default().direction` = (0.55, 0.45, 1)),
+/// from the side of the camera ([`render::camera::DEFAULT_VIEW_DIRECTION`]),
 /// so that surfaces facing the viewer are lit and folds show. Chosen by eye on the synthetic
 /// cloth and the horse gallop.
 const KEY_LIGHT_DIRECTION: Vec3 = Vec3::new(-0.2, 0.8, 0.6);
@@ -87,6 +85,16 @@ pub fn label_colours(count: usize) -> Vec<Vec3> {
         .collect()
 }
 
+/// Per-vertex linear albedo from per-vertex labels in `0..count` ([`label_colours`]); a label
+/// out of range is drawn mid grey.
+pub fn label_albedo(labels: &[u32], count: usize) -> Vec<Vec3> {
+    let colours = label_colours(count);
+    labels
+        .iter()
+        .map(|&j| colours.get(j as usize).copied().unwrap_or(Vec3::splat(0.2)))
+        .collect()
+}
+
 /// What a strip shows: how many panels, their size, and the vertex colours.
 #[derive(Clone, Copy, Debug)]
 pub struct StripOptions<'a> {
@@ -106,7 +114,7 @@ pub struct StripOptions<'a> {
 /// # Errors
 /// [`Error::Request`] (naming `what`) when there are no frames or triangles, `count` is not in
 /// 1..=min([`MAX_STRIP_FRAMES`], frames) or a panel side is not in 1..=[`MAX_PANEL_SIDE`];
-/// [`Error::Gpu`] when rendering fails.
+/// [`Error::Render`] when rendering fails.
 pub fn render_strip(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -144,14 +152,15 @@ pub fn render_strip(
         bounding_sphere(frames.iter().flat_map(|f| used.iter().map(move |&i| &f[i])))
             .unwrap_or((Vec3::ZERO, 1.0));
     let [width, height] = panel_size;
-    let camera = crate::camera::resolve(
-        &CameraDesc {
-            width,
-            height,
-            ..CameraDesc::default()
-        },
+    let camera = Camera::framing(
         centre,
         radius,
+        centre,
+        render::camera::DEFAULT_VIEW_DIRECTION,
+        Vec3::Y,
+        render::camera::DEFAULT_FOV_Y_DEG,
+        width,
+        height,
     );
     // The seed's display mapping: the strip's shading is bounded by 1, no filmic curve needed.
     let display = Display {
@@ -230,17 +239,9 @@ pub fn check_strip(
 /// Writes `image` as a PNG that appears complete or not at all.
 ///
 /// # Errors
-/// [`Error::Io`] when encoding fails, [`Error::Mesh`] (an IO error naming the file) when
-/// writing fails.
+/// [`Error::Gpu`] (gpu-context's image output) naming the file when writing fails.
 pub fn write_png(path: &Path, image: &image::RgbaImage) -> Result<(), Error> {
-    let mut png = Vec::new();
-    image
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .map_err(|e| Error::Io {
-            path: path.to_owned(),
-            reason: e.to_string(),
-        })?;
-    meshio::write_atomic(path, |w| w.write_all(&png))?;
+    gpu_context::write_rgba8_png(path, image.as_raw(), image.width(), image.height())?;
     Ok(())
 }
 

@@ -348,3 +348,11 @@ pub(crate) fn token_text(token: &[u8]) -> String {
     }
     text
 }
+
+/// Atomic writes ([`atomic_out`], the workspace's one temp + rename) fail as [`MeshIoError::Io`]
+/// naming the target and the step (`create`, `write`, `sync`, `rename a temporary file onto`).
+impl From<atomic_out::WriteError> for MeshIoError {
+    fn from(e: atomic_out::WriteError) -> Self {
+        Self::io(&e.path, e.op, e.source)
+    }
+}

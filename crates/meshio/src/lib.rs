@@ -29,8 +29,8 @@
 //! Output: [`write_npy_f32`]; [`write_glb`] (a [`GlbMesh`] with normals, linear float
 //! `COLOR_0` and custom scalar attributes such as `_AO`); [`write_glb_animation`] (frames as
 //! morph targets driven by a `STEP` weights clip, read back by [`load_animation`]). All writers
-//! validate first and write atomically (through [`atomic_out`]; [`write_atomic`] returns its
-//! errors as [`MeshIoError`]).
+//! validate first and write atomically (through [`atomic_out`], whose errors arrive as
+//! [`MeshIoError::Io`]).
 //!
 //! # Examples
 //! ```
@@ -50,7 +50,6 @@
 //! assert_eq!(report.vertex_remap.unwrap()[4], None);
 //! ```
 
-mod atomic;
 mod error;
 mod gltf;
 mod normals;
@@ -65,7 +64,6 @@ mod validate;
 
 use std::path::Path;
 
-pub use atomic::write_atomic;
 pub use error::MeshIoError;
 pub use gltf::{
     GlbMesh, MAX_VIEWLESS_ELEMENTS, NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation,

@@ -83,6 +83,13 @@ const FAR_MULTIPLE: f32 = 1e2;
 /// field of view (tuned by eye on the demo: the cloth and ball with a little air around).
 pub const FRAMING_MARGIN: f32 = 1.08;
 
+/// The default direction from the subject towards the eye for [`Camera::framing`]: in front,
+/// a little above and to the right, so that a cloth draped over a ball shows its folds and the
+/// floor (scene files' `[camera] direction`, strips, `cloth-vis visibility --render`).
+pub const DEFAULT_VIEW_DIRECTION: Vec3 = Vec3::new(0.55, 0.45, 1.0);
+/// The default vertical field of view in degrees (a normal lens on a 35 mm frame).
+pub const DEFAULT_FOV_Y_DEG: f32 = 35.0;
+
 impl Camera {
     /// A camera at `eye` looking at `target`, with clipping planes at 1/100 and 100 times the
     /// eye–target distance (set `near`/`far` to change them).

@@ -16,8 +16,8 @@ use std::time::Instant;
 use btf::{BtfDir, BtfPca, BtfPcaParams, ErrorStats, Sampling};
 use glam::Vec3;
 
-use crate::Error;
-use crate::run::progress_bar as bar;
+use cloth_vis::Error;
+use cloth_vis::run::progress_bar as bar;
 
 /// What `cloth-vis btf synth` was asked to do.
 #[derive(Clone, Debug)]
@@ -396,7 +396,7 @@ impl RenderSummary {
 }
 
 /// The mesh of `btf render` as a world object with UVs.
-fn render_mesh(path: &Path) -> Result<crate::object::WorldObject, Error> {
+fn render_mesh(path: &Path) -> Result<cloth_vis::object::WorldObject, Error> {
     let (positions, triangles, uvs) = if path == Path::new("synth:cloth") {
         let anim = synth::simulate_cloth(&synth::ClothParams::default())?;
         let last = anim.frames.len() - 1;
@@ -412,7 +412,7 @@ fn render_mesh(path: &Path) -> Result<crate::object::WorldObject, Error> {
         ));
     }
     let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
-    Ok(crate::object::WorldObject {
+    Ok(cloth_vis::object::WorldObject {
         name: path.display().to_string(),
         positions,
         normals,
@@ -449,14 +449,14 @@ pub fn run_render(
         ));
     }
     let [w, h] = request_.size;
-    if !(1..=crate::scene::MAX_IMAGE_SIDE).contains(&w)
-        || !(1..=crate::scene::MAX_IMAGE_SIDE).contains(&h)
+    if !(1..=cloth_vis::scene::MAX_IMAGE_SIDE).contains(&w)
+        || !(1..=cloth_vis::scene::MAX_IMAGE_SIDE).contains(&h)
     {
         return Err(request(
             &request_.out,
             format!(
                 "--size {w}x{h}: each side must be 1..={}",
-                crate::scene::MAX_IMAGE_SIDE
+                cloth_vis::scene::MAX_IMAGE_SIDE
             ),
         ));
     }
@@ -482,13 +482,13 @@ pub fn run_render(
     let object = render_mesh(&request_.mesh)?;
     let (centre, radius) =
         render::bounding_sphere(object.positions.iter()).unwrap_or((Vec3::ZERO, 1.0));
-    let desc = crate::scene::CameraDesc {
+    let desc = cloth_vis::scene::CameraDesc {
         width: w,
         height: h,
         direction: request_.camera_direction.to_array(),
-        ..crate::scene::CameraDesc::default()
+        ..cloth_vis::scene::CameraDesc::default()
     };
-    let framed = crate::camera::resolve(&desc, centre, radius);
+    let framed = cloth_vis::camera::resolve(&desc, centre, radius);
     let camera = render::Camera::look_at(
         framed.eye,
         framed.target,
@@ -511,21 +511,207 @@ pub fn run_render(
     params.uv_scale = glam::Vec2::splat(request_.uv_scale);
     let start = Instant::now();
     let objects = [&object];
-    let image = crate::btf_stage::render_objects(gpu, &pca, &objects, &light, &camera, &params)?;
+    let image =
+        cloth_vis::btf_stage::render_objects(gpu, &pca, &objects, &light, &camera, &params)?;
     let picture = if request_.beside_plain {
-        let plain = crate::btf_stage::plain_material(&pca)?;
+        let plain = cloth_vis::btf_stage::plain_material(&pca)?;
         let flat =
-            crate::btf_stage::render_objects(gpu, &plain, &objects, &light, &camera, &params)?;
-        crate::btf_stage::side_by_side(&image, &flat)
+            cloth_vis::btf_stage::render_objects(gpu, &plain, &objects, &light, &camera, &params)?;
+        cloth_vis::btf_stage::side_by_side(&image, &flat)
     } else {
-        crate::btf_stage::single(&image)
+        cloth_vis::btf_stage::single(&image)
     };
     let seconds = start.elapsed().as_secs_f64();
-    crate::strip::write_png(&request_.out, &picture)?;
+    figures::strip::write_png(&request_.out, &picture)?;
     Ok(RenderSummary {
         mesh: (object.positions.len(), object.triangles.len()),
         size: [picture.width(), picture.height()],
         backend: if gpu.is_some() { "gpu" } else { "cpu" },
         seconds,
     })
+}
+
+/// The `btf` subcommands.
+#[derive(clap::Subcommand)]
+pub enum BtfCommand {
+    /// Write the synthetic woven-cloth BTF as 81 × 81 PNGs named as the Bonn UBO2003 archives
+    /// (tl… pl… tv… pv….png) into a new folder.
+    Synth(SynthArgs),
+    /// Compress a BTF folder by per-view PCA (§5.4) into a .btfpca file.
+    Compress(CompressArgs),
+    /// Compare a .btfpca with its folder: sizes, RMS error (8-bit sRGB) and PSNR over every
+    /// image.
+    Stats(StatsArgs),
+    /// Render a mesh with UVs textured by a compressed BTF under one light (§5.5), to PNG.
+    Render(RenderArgs),
+}
+
+impl BtfCommand {
+    /// Run the subcommand; print its summary line.
+    pub fn run(self) -> anyhow::Result<()> {
+        let line = match self {
+            Self::Synth(a) => run_synth(&SynthRequest {
+                params: synth::WovenBtfParams {
+                    res: a.res,
+                    supersample: a.supersample,
+                    ..Default::default()
+                },
+                sampling: a.sampling,
+                out: a.out,
+                progress: !a.quiet,
+            })?
+            .line(),
+            Self::Compress(a) => run_compress(&CompressRequest {
+                dir: a.dir,
+                params: BtfPcaParams {
+                    components: a.components,
+                    storage: a.storage,
+                    mean_storage: a.mean_storage,
+                    ..Default::default()
+                },
+                out: a.out,
+                progress: !a.quiet,
+            })?
+            .line(),
+            Self::Stats(a) => run_stats(&a.dir, &a.file, false)?.line(),
+            Self::Render(a) => a.run()?,
+        };
+        super::print_line(&line)
+    }
+}
+
+/// `cloth-vis btf synth`.
+#[derive(clap::Args)]
+pub struct SynthArgs {
+    /// Texels per image side (the thesis's normtextures are 256).
+    #[arg(long, default_value_t = synth::WovenBtfParams::default().res)]
+    res: usize,
+    /// Measured directions: h1 (θ up to 85°) or h2 (θ up to 75°), Table 5.1.
+    #[arg(long, default_value = "h1", value_parser = parse_sampling)]
+    sampling: Sampling,
+    /// Rays per texel side (anti-aliasing of the mesostructure).
+    #[arg(long, default_value_t = synth::WovenBtfParams::default().supersample)]
+    supersample: usize,
+    /// Output folder (must not exist, or be empty).
+    #[arg(long)]
+    out: PathBuf,
+    /// Hide the progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// `cloth-vis btf compress`.
+#[derive(clap::Args)]
+pub struct CompressArgs {
+    /// The folder of 81 × 81 images (UBO2003 names; PNG/JPEG sRGB or EXR linear).
+    dir: PathBuf,
+    /// c: eigen-normtextures per view slot (clamped to each slot's rank, at most 80).
+    #[arg(long, default_value_t = btf::DEFAULT_COMPONENTS)]
+    components: usize,
+    /// Bits of the eigen-normtextures: u8 (the thesis's), u16 or f32.
+    #[arg(long, default_value = "u8", value_parser = parse_storage)]
+    storage: btf::Storage,
+    /// Bits of the mean normtextures: u8, u16 (default) or f32.
+    #[arg(long, default_value = "u16", value_parser = parse_storage)]
+    mean_storage: btf::Storage,
+    /// Output: FILE.btfpca.
+    #[arg(long)]
+    out: PathBuf,
+    /// Hide the progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// `cloth-vis btf stats`.
+#[derive(clap::Args)]
+pub struct StatsArgs {
+    /// The BTF folder.
+    dir: PathBuf,
+    /// The .btfpca file.
+    file: PathBuf,
+}
+
+/// `cloth-vis btf render`.
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// A mesh with per-vertex UVs (.obj .ply .gltf .glb) or synth:cloth.
+    mesh: PathBuf,
+    /// The .btfpca material.
+    #[arg(long)]
+    btf: PathBuf,
+    /// Directional light: world direction towards it.
+    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, conflicts_with = "light_pos")]
+    light_dir: Option<Vec3>,
+    /// Point light: world position (no distance falloff).
+    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3)]
+    light_pos: Option<Vec3>,
+    /// Linear RGB radiance of the light.
+    #[arg(long, value_name = "R,G,B", value_parser = super::parse::vec3, default_value = "1,1,1")]
+    radiance: Vec3,
+    /// Direction from the mesh towards the camera, which frames the mesh.
+    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, default_value = "0.55,0.45,1")]
+    camera_dir: Vec3,
+    /// Image size.
+    #[arg(long, value_name = "WxH", value_parser = super::parse::size, default_value = "512x512")]
+    size: [u32; 2],
+    /// Texture repeats across the mesh's UV range.
+    #[arg(long, default_value_t = 4.0)]
+    uv_scale: f32,
+    /// Also draw plain texture mapping of the same material beside it (Fig. 5.16).
+    #[arg(long)]
+    beside_plain: bool,
+    /// Use the CPU reference renderer (no GPU needed).
+    #[arg(long)]
+    cpu: bool,
+    /// Output: IMAGE.png.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+impl RenderArgs {
+    /// Render; the summary line.
+    fn run(self) -> anyhow::Result<String> {
+        let light = match (self.light_dir, self.light_pos) {
+            (Some(d), _) => RenderLight::Direction(d),
+            (None, Some(p)) => RenderLight::Position(p),
+            (None, None) => {
+                anyhow::bail!("give the light: --light-dir X,Y,Z or --light-pos X,Y,Z")
+            }
+        };
+        let gpu = if self.cpu {
+            None
+        } else {
+            super::optional_gpu()
+        };
+        let request = RenderRequest {
+            mesh: self.mesh,
+            btf: self.btf,
+            light,
+            radiance: self.radiance,
+            camera_direction: self.camera_dir,
+            size: self.size,
+            uv_scale: self.uv_scale,
+            beside_plain: self.beside_plain,
+            cpu: self.cpu,
+            out: self.out,
+        };
+        Ok(run_render(&request, gpu.as_ref())?.line())
+    }
+}
+
+fn parse_sampling(text: &str) -> Result<Sampling, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "h1" => Ok(Sampling::H1),
+        "h2" => Ok(Sampling::H2),
+        _ => Err(format!("{text:?}: the samplings are h1 and h2 (Table 5.1)")),
+    }
+}
+
+fn parse_storage(text: &str) -> Result<btf::Storage, String> {
+    match text.to_ascii_lowercase().as_str() {
+        "u8" => Ok(btf::Storage::U8),
+        "u16" => Ok(btf::Storage::U16),
+        "f32" => Ok(btf::Storage::F32),
+        _ => Err(format!("{text:?}: the storages are u8, u16 and f32")),
+    }
 }

@@ -9,7 +9,7 @@
 //! - `stats` compares a `.cpca` with its original: bpvf by eqs. 3.16–3.18 and from the file
 //!   size, d_a (Karni–Gotsman) and the worst d_f.
 //!
-//! Every output is written atomically (`meshio::write_atomic`): a refused request or a
+//! Every output is written atomically (`atomic_out::write_with`): a refused request or a
 //! failed decode leaves no partial file behind. A corrupt `.cpca` gets the decoder's error
 //! prefixed with the file's path.
 
@@ -23,7 +23,7 @@ use anim_pca::compress::{
 };
 use glam::Vec3;
 
-use crate::Error;
+use cloth_vis::Error;
 
 /// What `cloth-vis anim compress` was asked to do.
 #[derive(Clone, Debug)]
@@ -332,7 +332,7 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
     let distortion = Decoder::new(&packed)
         .distortion(&clip.frames)
         .map_err(|e| anim_error(&request.input, e))?;
-    meshio::write_atomic(&request.out, |w| w.write_all(&bytes))?;
+    atomic_out::write_with(&request.out, |w| w.write_all(&bytes))?;
     Ok(CompressSummary {
         vertices: packed.vertices(),
         frames: packed.frames(),
@@ -387,6 +387,7 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
 /// A corrupt `.cpca` (the decoder's message prefixed with its path); loader errors naming the
 /// original; a vertex or frame count that differs between the two, naming both files and
 /// counts.
+#[cfg(test)]
 pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
     run_stats_with_pictures(
         &StatsRequest {
@@ -407,18 +408,18 @@ pub struct StatsRequest {
     /// The `.cpca` file.
     pub cpca: PathBuf,
     /// Write the decoded mesh coloured by cluster (thesis Figs. 3.12/3.13) here, as a PNG
-    /// strip of [`crate::strip::DEFAULT_STRIP_FRAMES`] frames (needs a GPU adapter; Mesa's
+    /// strip of [`figures::strip::DEFAULT_STRIP_FRAMES`] frames (needs a GPU adapter; Mesa's
     /// lavapipe will do).
     pub clusters_png: Option<PathBuf>,
     /// Write d_f against the frame index (thesis Fig. 3.15) here, as an SVG chart.
     pub error_plot: Option<PathBuf>,
 }
 
-/// Runs `stats` ([`run_stats`]) and writes the pictures `request` asks for. `gpu` is needed
+/// Runs `stats` (bpvf, d_a, worst d_f) and writes the pictures `request` asks for. `gpu` is needed
 /// only for `clusters_png`.
 ///
 /// # Errors
-/// As [`run_stats`]; a picture path with the wrong extension (refused before any work); a
+/// A corrupt `.cpca`, loader errors and count mismatches, naming the files; a picture path with the wrong extension (refused before any work); a
 /// missing GPU for `clusters_png` or a file without triangles ([`Error::Request`]);
 /// rendering and write errors naming the picture.
 pub fn run_stats_with_pictures(
@@ -471,11 +472,11 @@ pub fn run_stats_with_pictures(
         .map_err(|e| anim_error(original, e))?;
     if let (Some(png), Some(gpu)) = (&request.clusters_png, gpu) {
         let image = cluster_strip(gpu, &data, png)?;
-        crate::strip::write_png(png, &image)?;
+        figures::strip::write_png(png, &image)?;
     }
     if let Some(svg) = &request.error_plot {
         let chart = error_chart(&distortion, cpca);
-        meshio::write_atomic(svg, |w| w.write_all(chart.as_bytes()))?;
+        atomic_out::write_with(svg, |w| w.write_all(chart.as_bytes()))?;
     }
     Ok(StatsSummary {
         rate: data.rate(),
@@ -495,25 +496,24 @@ pub fn cluster_strip(
     what: &Path,
 ) -> Result<image::RgbaImage, Error> {
     let frames = Decoder::new(data).decode_all();
-    let colours = crate::strip::label_colours(data.clusters());
-    let albedo: Vec<Vec3> = data.labels().iter().map(|&j| colours[j as usize]).collect();
-    crate::strip::render_strip(
+    let albedo = figures::strip::label_albedo(data.labels(), data.clusters());
+    Ok(figures::strip::render_strip(
         &gpu.device,
         &gpu.queue,
         &frames,
         data.triangles(),
-        &crate::strip::StripOptions {
-            count: crate::strip::DEFAULT_STRIP_FRAMES.min(frames.len()),
-            panel_size: crate::strip::DEFAULT_PANEL_SIZE,
+        &figures::strip::StripOptions {
+            count: figures::strip::DEFAULT_STRIP_FRAMES.min(frames.len()),
+            panel_size: figures::strip::DEFAULT_PANEL_SIZE,
             albedo: Some(&albedo),
         },
         what,
-    )
+    )?)
 }
 
 /// d_f per frame (thesis Fig. 3.15) as an SVG chart titled after `cpca`.
 pub fn error_chart(distortion: &Distortion, cpca: &Path) -> String {
-    use crate::plot::{Axis, Series, chart_svg};
+    use figures::chart::{Axis, Series, chart_svg};
     let name = cpca
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
@@ -560,7 +560,7 @@ fn write_frames(
             meshio::write_glb_animation(out, &animation)?;
         }
         OutKind::ObjFolder => {
-            crate::anim_cmd::write_obj_frames(out, &frames, triangles, "cloth-vis anim decompress")?
+            super::jumpmap::write_obj_frames(out, &frames, triangles, "cloth-vis anim decompress")?
         }
     }
     Ok(())
@@ -575,5 +575,123 @@ fn glb_frame_rate(rate: f32) -> f32 {
         rate
     } else {
         FALLBACK_FRAME_RATE
+    }
+}
+
+/// `cloth-vis anim compress`: the flags of a [`CompressRequest`].
+#[derive(clap::Args)]
+pub struct CompressArgs {
+    /// The clip: a folder of numbered .obj frames, .npy [F, V, 3] or an animated .glb.
+    input: PathBuf,
+    /// k: vertex clusters (clamped to V).
+    #[arg(long, default_value_t = CpcaParams::default().clusters)]
+    clusters: usize,
+    /// c: eigentrajectories per cluster (clamped to 3F).
+    #[arg(long, default_value_t = CpcaParams::default().components)]
+    components: usize,
+    /// c*: components of the second PCA along time (default: none).
+    #[arg(long, value_name = "C*")]
+    time_components: Option<usize>,
+    /// q_c: bits of the means and eigentrajectories, 1..=32.
+    #[arg(long, value_name = "BITS", default_value_t = anim_pca::compress::DEFAULT_BITS)]
+    qc: u8,
+    /// q_w: bits of the weights, 1..=32.
+    #[arg(long, value_name = "BITS", default_value_t = anim_pca::compress::DEFAULT_BITS)]
+    qw: u8,
+    /// Seed of the local PCA (same seed, same file).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Instead of --clusters: the smallest k (from 1) whose decoded clip has d_a ≤ X.
+    #[arg(long, value_name = "X", conflicts_with_all = ["clusters", "target_bpvf"])]
+    target_da: Option<f64>,
+    /// Instead of --clusters: the k of lowest d_a whose file needs ≤ X bits per vertex
+    /// per frame.
+    #[arg(long, value_name = "X", conflicts_with = "clusters")]
+    target_bpvf: Option<f64>,
+    /// Largest k a --target-da/--target-bpvf search tries.
+    #[arg(long, default_value_t = DEFAULT_K_MAX)]
+    k_max: usize,
+    /// Output: FILE.cpca.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+impl CompressArgs {
+    /// Encode and write; print the summary line.
+    pub fn run(self) -> anyhow::Result<()> {
+        let target = match (self.target_da, self.target_bpvf) {
+            (Some(x), _) => Some(RateTarget::Distortion(x)),
+            (None, Some(x)) => Some(RateTarget::Bpvf(x)),
+            (None, None) => None,
+        };
+        let request = CompressRequest {
+            input: self.input,
+            params: CpcaParams {
+                clusters: self.clusters,
+                components: self.components,
+                time_components: self.time_components,
+                bits_components: self.qc,
+                bits_weights: self.qw,
+                seed: self.seed,
+                ..Default::default()
+            },
+            target,
+            k_max: self.k_max,
+            out: self.out,
+        };
+        super::print_line(&run_compress(&request)?.line())
+    }
+}
+
+/// `cloth-vis anim decompress`: the flags of a [`DecompressRequest`].
+#[derive(clap::Args)]
+pub struct DecompressArgs {
+    /// The .cpca file.
+    input: PathBuf,
+    /// Output: FILE.npy, FILE.glb or a folder name (OBJ frames).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+impl DecompressArgs {
+    /// Decode and write; print the summary line.
+    pub fn run(self) -> anyhow::Result<()> {
+        let request = DecompressRequest {
+            input: self.input,
+            out: self.out,
+        };
+        super::print_line(&run_decompress(&request)?.line())
+    }
+}
+
+/// `cloth-vis anim stats`: the flags of a [`StatsRequest`].
+#[derive(clap::Args)]
+pub struct StatsArgs {
+    /// The original clip (folder of .obj frames, .npy or .glb).
+    original: PathBuf,
+    /// The .cpca file.
+    cpca: PathBuf,
+    /// Also write the decoded mesh coloured by cluster (Figs. 3.12/3.13) as a PNG strip.
+    #[arg(long, value_name = "FILE.png")]
+    clusters_png: Option<PathBuf>,
+    /// Also write d_f against the frame (Fig. 3.15) as an SVG chart.
+    #[arg(long, value_name = "FILE.svg")]
+    error_plot: Option<PathBuf>,
+}
+
+impl StatsArgs {
+    /// Compare, write the pictures asked for; print the summary line.
+    pub fn run(self) -> anyhow::Result<()> {
+        let gpu = self
+            .clusters_png
+            .as_ref()
+            .and_then(|_| super::optional_gpu());
+        let request = StatsRequest {
+            original: self.original,
+            cpca: self.cpca,
+            clusters_png: self.clusters_png,
+            error_plot: self.error_plot,
+        };
+        super::print_line(&run_stats_with_pictures(&request, gpu.as_ref())?.line())
     }
 }

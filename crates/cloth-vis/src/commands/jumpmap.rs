@@ -2,7 +2,7 @@
 //! (thesis §3.2, crate `anim-pca`), written as `.npy` [N, V, 3], a `.glb` morph-target
 //! animation or a folder of numbered OBJ frames, with the analysis matrices D, D*, P, P*, P̂
 //! as PNG heat maps (the thesis's Fig. 3.3) and a rendered strip of frames of the new
-//! sequence ([`crate::strip`]).
+//! sequence ([`figures::strip`]).
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -11,8 +11,8 @@ use anim_pca::{Blend, Clip, JumpMap, JumpMapParams, LoopTable, PlaybackParams, P
 use glam::Vec3;
 use gpu_context::GpuContext;
 
-use crate::Error;
-use crate::strip::{check_strip, render_strip, write_png};
+use cloth_vis::Error;
+use figures::strip::{check_strip, render_strip, write_png};
 
 /// A rendered strip of frames of the generated sequence (`--strip`).
 #[derive(Clone, Debug, PartialEq)]
@@ -20,20 +20,21 @@ pub struct StripRequest {
     /// The `.png` to write.
     pub path: PathBuf,
     /// Panels K: frames shown, evenly spaced over the generated run from its first to its
-    /// last frame (default [`crate::strip::DEFAULT_STRIP_FRAMES`]).
+    /// last frame (default [`figures::strip::DEFAULT_STRIP_FRAMES`]).
     pub frames: usize,
     /// Size of one panel in pixels (width, height); the image is K · width × height.
     pub panel_size: [u32; 2],
 }
 
+#[cfg(test)]
 impl StripRequest {
-    /// A strip of the default [`crate::strip::DEFAULT_STRIP_FRAMES`] panels of the default
+    /// A strip of the default [`figures::strip::DEFAULT_STRIP_FRAMES`] panels of the default
     /// size into `path`.
     pub fn new(path: PathBuf) -> Self {
         Self {
             path,
-            frames: crate::strip::DEFAULT_STRIP_FRAMES,
-            panel_size: crate::strip::DEFAULT_PANEL_SIZE,
+            frames: figures::strip::DEFAULT_STRIP_FRAMES,
+            panel_size: figures::strip::DEFAULT_PANEL_SIZE,
         }
     }
 }
@@ -307,7 +308,7 @@ pub fn run_jumpmap(
             &gpu.queue,
             &frames,
             &clip.triangles,
-            &crate::strip::StripOptions {
+            &figures::strip::StripOptions {
                 count: strip.frames,
                 panel_size: strip.panel_size,
                 albedo: None,
@@ -372,7 +373,7 @@ pub(crate) fn write_obj_frames(
     })?;
     for (f, positions) in frames.iter().enumerate() {
         let path = dir.join(format!("frame_{f:05}.obj"));
-        meshio::write_atomic(&path, |w| {
+        atomic_out::write_with(&path, |w| {
             writeln!(w, "# {what}, frame {f}")?;
             for p in positions {
                 writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
@@ -452,7 +453,7 @@ fn write_heat_map(path: &Path, matrix: &anim_pca::SquareMatrix, log: bool) -> Re
         let [r, g, b] = ramp(value(y as usize / scale, x as usize / scale));
         image::Rgba([r, g, b, 255])
     });
-    write_png(path, &image)
+    Ok(write_png(path, &image)?)
 }
 
 /// Parses `--cell-at FRAME:CELL`.
@@ -478,5 +479,139 @@ pub fn blend_from_flags(blend: Option<usize>, smoothness: Option<f64>) -> Blend 
         (Some(0), None) => Blend::None,
         (Some(b), None) => Blend::Fixed(b),
         (None, None) => Blend::Fixed(3),
+    }
+}
+
+/// `cloth-vis anim jumpmap`: the flags of a [`JumpMapRequest`].
+#[derive(clap::Args)]
+pub struct JumpmapArgs {
+    /// The clip: a folder of numbered .obj frames, .npy [F, V, 3] or an animated .glb.
+    input: PathBuf,
+    /// A further clip of the same mesh, analysed as the next cell (motion control,
+    /// thesis §3.2.2); repeat for more cells. The input is cell 0.
+    #[arg(long, value_name = "CLIP")]
+    cell: Vec<PathBuf>,
+    /// From generated frame FRAME on, move into cell CELL at the best transition ahead;
+    /// repeat to script a route (e.g. --cell-at 200:1 --cell-at 500:0).
+    #[arg(long, value_name = "FRAME:CELL", value_parser = parse_cell_at)]
+    cell_at: Vec<(usize, usize)>,
+    /// Play the cheapest loop of exactly N frames (blend frames included), repeated,
+    /// instead of random play.
+    #[arg(long = "loop", value_name = "N", conflicts_with = "cell_at")]
+    loop_length: Option<usize>,
+    /// Take the clip's travel out before the analysis and replay it by integration (for
+    /// clips that walk across the scene).
+    #[arg(long)]
+    root_motion: bool,
+    /// c: PCA components of the frames.
+    #[arg(long, default_value_t = 10)]
+    components: usize,
+    /// c*: PCA components of the central velocities.
+    #[arg(long, default_value_t = 5)]
+    velocity_components: usize,
+    /// σ (eq. 3.3), in units of the clip's mean frame-to-frame-pair distance.
+    #[arg(long, default_value_t = 0.05)]
+    sigma: f64,
+    /// σ* (eq. 3.6), in the same units for velocities.
+    #[arg(long, default_value_t = 0.05)]
+    sigma_v: f64,
+    /// q (eq. 3.8): base probability of the position term, 0..1.
+    #[arg(long, default_value_t = 0.0)]
+    q: f64,
+    /// q* (eq. 3.8): base probability of the velocity term, 0..1.
+    #[arg(long, default_value_t = 0.0)]
+    qv: f64,
+    /// m: recently visited frames forbidden as jump targets (< 5).
+    #[arg(long, default_value_t = 2)]
+    memory: usize,
+    /// b: blend frames per transition (0 = cut; default 3).
+    #[arg(long, conflicts_with = "smoothness")]
+    blend: Option<usize>,
+    /// s: variable-length blends from a smoothness (eq. 3.11), in mean frame steps.
+    #[arg(long)]
+    smoothness: Option<f64>,
+    /// Frames to generate.
+    #[arg(long, default_value_t = 300)]
+    frames: usize,
+    /// Seed of the jumps (same seed, same animation).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Output: FILE.npy, FILE.glb or a folder name (OBJ frames).
+    #[arg(long)]
+    out: PathBuf,
+    /// Folder for the heat maps of D, D*, P, P*, P̂ (PNG).
+    #[arg(long)]
+    maps: Option<PathBuf>,
+    /// Render evenly spaced frames of the new sequence side by side into FILE.png, one
+    /// camera framing the whole run. Needs a GPU adapter (lavapipe is fine).
+    #[arg(long, value_name = "FILE")]
+    strip: Option<PathBuf>,
+    /// Frames K shown in the --strip (first to last, evenly spaced).
+    #[arg(
+        long,
+        value_name = "K",
+        requires = "strip",
+        default_value_t = figures::strip::DEFAULT_STRIP_FRAMES
+    )]
+    strip_frames: usize,
+    /// Size of one --strip panel; the image is K·W × H.
+    #[arg(
+        long,
+        value_name = "WxH",
+        requires = "strip",
+        value_parser = super::parse::size,
+        default_value = "256x256"
+    )]
+    strip_size: [u32; 2],
+}
+
+impl JumpmapArgs {
+    /// The request these flags describe.
+    fn request(self) -> JumpMapRequest {
+        JumpMapRequest {
+            input: self.input,
+            params: JumpMapParams {
+                components: self.components,
+                velocity_components: self.velocity_components,
+                sigma: self.sigma,
+                sigma_velocity: self.sigma_v,
+                q: self.q,
+                q_velocity: self.qv,
+                root_motion: if self.root_motion {
+                    anim_pca::RootMotion::Extract
+                } else {
+                    anim_pca::RootMotion::Keep
+                },
+                ..Default::default()
+            },
+            control: PlayControl {
+                cells: self.cell,
+                cell_at: self.cell_at,
+                loop_length: self.loop_length,
+            },
+            playback: PlaybackParams {
+                memory: self.memory,
+                blend: blend_from_flags(self.blend, self.smoothness),
+                seed: self.seed,
+                ..Default::default()
+            },
+            frames: self.frames,
+            out: self.out,
+            maps: self.maps,
+            strip: self.strip.map(|path| StripRequest {
+                path,
+                frames: self.strip_frames,
+                panel_size: self.strip_size,
+            }),
+        }
+    }
+
+    /// Generate and write; print the summary line.
+    pub fn run(self) -> anyhow::Result<()> {
+        let request = self.request();
+        // --strip without an adapter is refused by run_jumpmap, naming the flag.
+        let gpu = request.strip.as_ref().and_then(|_| super::optional_gpu());
+        let summary = run_jumpmap(&request, gpu.as_ref())?;
+        super::print_line(&summary.line())
     }
 }

@@ -2,6 +2,11 @@
 //! frame of an animation (paper 000), written as `.npy` arrays, a coloured `.ply` or a `.glb`,
 //! and optionally rendered to a PNG or EXR image.
 //!
+//! It is a one-object scene ([`Scene::one_object`]) run through the library's stages: the
+//! geometry loader, the light directions, [`VisibilityStage`] (one engine for every frame),
+//! [`shadowed_radiance`] and [`render_still_image`] — the same code `cloth-vis render` runs,
+//! with this command's outputs on top.
+//!
 //! Arrays keep the input's vertex order and count; a vertex used by no face has a zero normal
 //! and gets a_i = NaN (and an all-zero row of M). Only the visibility computation is timed.
 //!
@@ -13,8 +18,11 @@
 //! Environment rotation (paper 000 §5, thesis §4.4.5: "When the environment map is rotated
 //! relative to the object, the light directions are multiplied by the same rotation matrix to
 //! obtain the new look-up positions"): rotating the environment by R about +Y reads I_j at the
-//! look-up direction R⁻¹·l_j ([`light_radiance`]); M is not recomputed. A quarter turn maps the
-//! octahedral directions onto each other, so it only permutes the I_j.
+//! look-up direction R⁻¹·l_j ([`cloth_vis::lighting::rotated_lookup_radiance`]); M is not
+//! recomputed. The command rotates the environment itself by the same f64-built rotation
+//! ([`environment_rotation`]), which equals the rotated look-ups to rounding (tested) and turns
+//! the backdrop with it. A quarter turn maps the octahedral directions onto each other, so it
+//! only permutes the I_j.
 //!
 //! Outputs by extension:
 //! - `.npy`: a_i as f32 `[N]` (`[F, N]` for several frames), or M as `[N, k]` / `[F, N, k]`;
@@ -26,29 +34,33 @@
 //!   **−1 for unused vertices** because glTF forbids NaN in accessor data;
 //! - `--render FILE.png|FILE.exr`: the last frame drawn by the shared frame of crate `render` (Gouraud, both
 //!   sides with c_i, the environment as backdrop when one is given) from an automatically
-//!   framed camera; PNG tone-mapped with `2^EV` exposure (default: the 90th percentile of the
-//!   used vertices' luminance maps to 0.8) and gamma, EXR linear. Needs a GPU adapter
+//!   framed camera; PNG tone-mapped with `2^EV` exposure (default: automatic, the 90th
+//!   percentile of the object's pixel luminance maps to 0.8, the backdrop never counts) and
+//!   clamp-then-gamma, EXR linear. Needs a GPU adapter
 //!   (lavapipe is fine).
 
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use glam::{DQuat, Quat, Vec3};
-use gpu_context::{GpuContext, HdrImage};
-use occlusion_gpu::{Backend, DepthParams, VisibilityEngine, VisibilityParams};
-use render::tone::{Display, ToneCurve};
-use render::{Backdrop, Background, DrawMesh, FrameFormat, Renderer, bounding_sphere};
+use cloth_vis::Error;
+use cloth_vis::lighting::{environment_rotation, shadowed_radiance};
+use cloth_vis::run::render_still_image;
+use cloth_vis::scene::{
+    AutoKeyword, BackgroundDesc, BackgroundKeyword, ExposureDesc, Scene, ToneDesc,
+    VisibilityBackendDesc,
+};
+use cloth_vis::shadowing::VisibilityStage;
+use glam::Vec3;
+use gpu_context::GpuContext;
+use occlusion_gpu::Backend;
 
-use crate::Error;
-use crate::scene::CameraDesc;
-
-/// Where automatic exposure puts the 90th percentile of the used vertices' luminance.
+/// Where the colours of `.ply`/`.glb` outputs put the 90th percentile of vertex luminance.
 const AUTO_EXPOSURE_KEY: f32 = render::tone::AUTO_EXPOSURE_KEY;
 /// Default display gamma of `--render` PNGs and of `.ply` colours.
 pub const DEFAULT_GAMMA: f32 = 2.2;
-/// Default `--render` image size (width, height).
-pub const DEFAULT_RENDER_SIZE: [u32; 2] = [768, 768];
+/// Default `--render-size` (width x height).
+const DEFAULT_RENDER_SIZE: &str = "768x768";
 /// `_AO` value of a vertex used by no face in a `.glb` (glTF forbids NaN).
 pub const GLB_UNUSED_AO: f32 = -1.0;
 
@@ -86,6 +98,7 @@ pub struct VisibilityRequest {
     pub render_size: [u32; 2],
 }
 
+#[cfg(test)]
 impl VisibilityRequest {
     /// A request for `input` with the command line's defaults: level 3, automatic backend,
     /// default depth resolution, no environment, no output, all frames, no render.
@@ -103,7 +116,7 @@ impl VisibilityRequest {
             render: None,
             exposure_ev: None,
             gamma: DEFAULT_GAMMA,
-            render_size: DEFAULT_RENDER_SIZE,
+            render_size: super::parse::size(DEFAULT_RENDER_SIZE).expect("the default parses"),
         }
     }
 }
@@ -262,7 +275,36 @@ const MAX_RENDER_SIDE: u32 = 8192;
 /// Largest `--exposure` magnitude in stops (2^±64 covers every f32 radiance range).
 const MAX_EXPOSURE_EV: f32 = 64.0;
 
-/// Run the request. `gpu` is needed for the depth backend and for `render`.
+/// The one-object scene the request describes: the input as a white one-sided object, the
+/// lightsphere level, the visibility backend and depth resolution, an automatically framed
+/// camera of the render size, and the display mapping of `--render` PNGs (the seed's
+/// clamp-then-gamma with `--gamma`, exposure `--exposure` or automatic from the object's
+/// pixels; the backdrop when an environment is given, else black).
+fn one_object_scene(request: &VisibilityRequest) -> Result<Scene, Error> {
+    let mut scene = Scene::one_object(&request.input, "cloth-vis visibility")?;
+    scene.lighting.level = request.level;
+    scene.visibility.backend = match request.backend {
+        None => VisibilityBackendDesc::Auto,
+        Some(Backend::Cpu) => VisibilityBackendDesc::Cpu,
+        Some(Backend::Depth) => VisibilityBackendDesc::Depth,
+        Some(Backend::Query) => VisibilityBackendDesc::Query,
+    };
+    scene.visibility.depth_resolution = request.depth_resolution;
+    scene.camera.width = request.render_size[0];
+    scene.camera.height = request.render_size[1];
+    scene.output.exposure = match request.exposure_ev {
+        Some(ev) => ExposureDesc::Fixed(ev),
+        None => ExposureDesc::Auto(AutoKeyword::Auto),
+    };
+    scene.output.tone = ToneDesc::Clamp;
+    scene.output.gamma = request.gamma;
+    scene.output.background = BackgroundDesc::Named(BackgroundKeyword::Environment);
+    Ok(scene)
+}
+
+/// Run the request as a one-object scene through the library's stages (geometry, light
+/// directions, visibility, lighting, render). `gpu` is needed for the depth backend and for
+/// `render`.
 ///
 /// # Errors
 /// Loader, engine and output errors, naming the file; an unsupported output or image
@@ -275,17 +317,23 @@ pub fn run_visibility(
 ) -> Result<VisibilitySummary, Error> {
     let input = &request.input;
     let (out_kind, image_kind) = check_request(request, gpu)?;
+    let scene = one_object_scene(request)?;
     let sphere = lightsphere::Lightsphere::new(request.level)?;
-    let (frames, triangles) = load_frames(input)?;
-    let (start, end) = request.frames.unwrap_or((0, frames.len()));
-    if start >= end || end > frames.len() {
+    let (mut objects, _) = cloth_vis::inputs::load_geometry(&scene, false)?;
+    let object = &objects[0];
+    if object.triangles.is_empty() {
         return Err(invalid(
             input,
-            format!(
-                "--frames {start}..{end} is outside the {} frames (0..{})",
-                frames.len(),
-                frames.len()
-            ),
+            "the input has no triangles (an .npy animation carries none); pass a mesh instead"
+                .to_owned(),
+        ));
+    }
+    let total = object.frame_count();
+    let (start, end) = request.frames.unwrap_or((0, total));
+    if start >= end || end > total {
+        return Err(invalid(
+            input,
+            format!("--frames {start}..{end} is outside the {total} frames (0..{total})"),
         ));
     }
     let one_frame_ext = match out_kind {
@@ -299,62 +347,46 @@ pub fn run_visibility(
             format!("a .{ext} output holds one frame: pass --frames A..A+1"),
         ));
     }
-    let backend = request.backend.unwrap_or(match gpu {
-        Some(g) if !g.summary().is_software => Backend::Depth,
-        _ => Backend::Cpu,
+    let mut stage = VisibilityStage::new(&scene, gpu).map_err(|e| invalid(input, e.to_string()))?;
+    // Rotating the environment turns its backdrop and its I_j alike; M is computed once.
+    let environment = request.environment.clone().map(|env| {
+        let world_from_env = environment_rotation(request.env_rotation_deg) * env.world_from_env();
+        env.with_rotation(world_from_env)
     });
-    let params = VisibilityParams::default()
-        .with_depth(DepthParams::default().with_resolution(request.depth_resolution));
-    let mut engine = match (backend, gpu) {
-        (Backend::Cpu, _) => VisibilityEngine::cpu(params),
-        (other, Some(g)) => VisibilityEngine::with_gpu(&g.device, &g.queue, other, params),
-        (other, None) => {
-            return Err(invalid(
-                input,
-                format!(
-                    "backend {} needs a GPU adapter; use --backend cpu",
-                    other.name()
-                ),
-            ));
-        }
+    let light = match &environment {
+        Some(env) => Some(cloth_vis::inputs::light_directions(&scene, env)?.0.1),
+        None => None,
     };
-    let n = frames[0].len();
+    let n = objects[0].positions.len();
+    let k = sphere.len();
     let mut ambient = Vec::with_capacity((end - start) * n);
     let mut matrices = Vec::new();
     let mut last = None;
     let mut millis = 0.0;
-    for positions in &frames[start..end] {
-        let normals =
-            meshio::compute_normals(positions, &triangles, meshio::NormalWeighting::Angle);
-        let scene = occlusion_gpu::Scene::single(positions.clone(), normals, triangles.clone())?;
+    for frame in start..end {
+        objects[0].pose(frame);
         let t = Instant::now();
-        let m = engine.compute(&scene, &sphere)?;
+        let (visibility, _) = stage.compute(&objects, &sphere)?;
         millis += t.elapsed().as_secs_f64() * 1e3;
-        ambient.extend(m.ambient());
+        ambient.extend(visibility.matrix().ambient());
         if request.matrix {
-            matrices.extend(m.to_dense());
+            matrices.extend(visibility.matrix().to_dense());
         }
-        last = Some((positions, m));
+        last = Some(visibility);
     }
     let count = end - start;
-    let k = sphere.len();
-    let Some((positions, m)) = last else {
-        unreachable!("the frame range is non-empty");
-    };
+    let visibility = last.ok_or_else(|| invalid(input, "no frame to compute".to_owned()))?;
     let last_ambient = &ambient[(count - 1) * n..];
-    let radiance = match (&request.environment, out_kind, image_kind) {
+    // c_i = (1/π) Σ_j M_ij I_j ω_j of a white surface (NaN for unused vertices), or the grey
+    // ambient term a_i without an environment.
+    let radiance = match (&light, out_kind, image_kind) {
         (_, Some(OutKind::Npy) | None, None) => None,
-        (Some(env), _, _) => {
-            let light = light_radiance(env, &sphere, request.env_rotation_deg)?;
-            Some(vertex_radiance(&m, &sphere, &light)?)
-        }
-        (None, _, _) => Some(
-            last_ambient
-                .iter()
-                .map(|a| Vec3::splat(if a.is_finite() { *a } else { 0.0 }))
-                .collect::<Vec<_>>(),
-        ),
+        (Some(light), _, _) => Some(shadowed_radiance(visibility.matrix(), &sphere, light)?),
+        (None, _, _) => Some(last_ambient.iter().map(|a| Vec3::splat(*a)).collect()),
     };
+    let positions = &objects[0].positions;
+    let normals = visibility.matrix().normals();
+    let triangles = &objects[0].triangles;
     match (out_kind, &request.out, &radiance) {
         (Some(OutKind::Npy), Some(path), _) => {
             if request.matrix {
@@ -371,40 +403,27 @@ pub fn run_visibility(
         }
         (Some(OutKind::Ply), Some(path), Some(c)) => {
             let colours = display_colours(c);
-            write_ply(
-                path,
-                positions,
-                m.normals(),
-                &triangles,
-                &colours,
-                last_ambient,
-            )?;
+            write_ply(path, positions, normals, triangles, &colours, last_ambient)?;
         }
         (Some(OutKind::Glb), Some(path), Some(c)) => {
-            write_glb(path, positions, m.normals(), &triangles, c, last_ambient)?;
+            write_glb(path, positions, normals, triangles, c, last_ambient)?;
         }
         _ => {}
     }
     if let (Some(kind), Some(path), Some(gpu), Some(c)) =
         (image_kind, &request.render, gpu, &radiance)
     {
-        let image = render_vertices(request, gpu, positions, &triangles, c)?;
+        let lit: Vec<Vec3> = c
+            .iter()
+            .map(|v| if v.is_finite() { *v } else { Vec3::ZERO })
+            .collect();
+        objects[0].front = Some(lit.clone());
+        objects[0].back = Some(lit);
+        let (image, display, background) =
+            render_still_image(&scene, gpu, &objects, environment.as_ref())?;
         match kind {
-            ImageKind::Png => {
-                let exposure_ev = match request.exposure_ev {
-                    Some(ev) => ev,
-                    None => auto_exposure(c, m.normals()).log2(),
-                };
-                // `--gamma` keeps the seed's clamp-then-gamma mapping for this command.
-                let display = Display {
-                    exposure_ev,
-                    curve: ToneCurve::Clamp {
-                        gamma: request.gamma,
-                    },
-                };
-                render::output::write_png(&image, path, &display, Background::Environment)?;
-            }
-            ImageKind::Exr => render::output::write_exr(&image, path, Background::Environment)?,
+            ImageKind::Png => render::output::write_png(&image, path, &display, background)?,
+            ImageKind::Exr => render::output::write_exr(&image, path, background)?,
         }
     }
     Ok(VisibilitySummary {
@@ -412,138 +431,8 @@ pub fn run_visibility(
         vertices: n,
         frames: count,
         millis,
-        backend,
+        backend: stage.backend(),
     })
-}
-
-/// Radiance per light direction I_j of `env` rotated by `env_rotation_deg` about +Y relative
-/// to the object (on top of the environment's own `world_from_env`), by rotated look-ups:
-/// I_j is the environment's cell mean ([`lightsphere::RadianceMethod::CellMean`]) around the
-/// look-up direction R⁻¹·l_j, with R = rotation about +Y by `env_rotation_deg` (the seed's
-/// "light directions are multiplied by the same rotation matrix"). Equals
-/// `env.with_rotation(R · env.world_from_env()).radiance_per_direction(sphere, CellMean)` up
-/// to rounding, and the visibility matrix M (indexed by the unrotated l_j) is reused as is.
-///
-/// # Errors
-/// [`Error::Light`] for a non-finite angle.
-pub fn light_radiance(
-    env: &lightsphere::Environment,
-    sphere: &lightsphere::Lightsphere,
-    env_rotation_deg: f32,
-) -> Result<Vec<Vec3>, Error> {
-    let lookup = if env_rotation_deg == 0.0 {
-        sphere.clone()
-    } else {
-        sphere.try_rotated(env_rotation(env_rotation_deg).inverse())?
-    };
-    Ok(env.radiance_per_direction(&lookup, lightsphere::RadianceMethod::CellMean)?)
-}
-
-/// `world_from_rotated_env`: the rotation by `deg` about +Y, built in f64 so that quarter turns
-/// map the octahedral directions onto each other to f64 rounding.
-pub fn env_rotation(deg: f32) -> Quat {
-    DQuat::from_rotation_y(f64::from(deg).to_radians()).as_quat()
-}
-
-/// Vertex radiance of a white Lambertian surface: c_i = (1/π) Σ_j M_ij I_j ω_j (NaN for
-/// vertices used by no face).
-///
-/// # Errors
-/// When `light` does not have one value per direction of `sphere`.
-pub fn vertex_radiance(
-    m: &occlusion_gpu::VisibilityMatrix,
-    sphere: &lightsphere::Lightsphere,
-    light: &[Vec3],
-) -> Result<Vec<Vec3>, Error> {
-    let weights = sphere.light_weights(light)?;
-    Ok(m.radiance(&weights)?
-        .into_iter()
-        .map(|c| c / std::f32::consts::PI)
-        .collect())
-}
-
-/// Draw one frame with per-vertex radiance `c` (both sides) over the environment backdrop.
-fn render_vertices(
-    request: &VisibilityRequest,
-    gpu: &GpuContext,
-    positions: &[Vec3],
-    triangles: &[[u32; 3]],
-    c: &[Vec3],
-) -> Result<HdrImage, Error> {
-    let used: Vec<Vec3> = triangles
-        .iter()
-        .flatten()
-        .map(|&i| positions[i as usize])
-        .collect();
-    let (centre, radius) = bounding_sphere(&used).unwrap_or((Vec3::ZERO, 1.0));
-    let desc = CameraDesc {
-        width: request.render_size[0],
-        height: request.render_size[1],
-        ..CameraDesc::default()
-    };
-    let camera = crate::camera::resolve(&desc, centre, radius);
-    let colours: Vec<Vec3> = c
-        .iter()
-        .map(|v| if v.is_finite() { *v } else { Vec3::ZERO })
-        .collect();
-    let mesh = DrawMesh {
-        positions,
-        triangles,
-        front: &colours,
-        back: &colours,
-    };
-    let backdrop = request.environment.as_ref().map(|env| Backdrop {
-        width: env.width(),
-        height: env.height(),
-        texels: env.texels(),
-        world_from_env: env_rotation(request.env_rotation_deg) * env.world_from_env(),
-    });
-    let mut renderer = Renderer::new(&gpu.device, FrameFormat::for_context(gpu));
-    let background = if backdrop.is_some() {
-        Background::Environment
-    } else {
-        Background::Color([0.0; 3])
-    };
-    renderer.backdrop.set_environment(&gpu.device, backdrop);
-    renderer
-        .gouraud
-        .set_meshes(&gpu.device, &gpu.queue, &[mesh])?;
-    Ok(renderer.render(&gpu.device, &gpu.queue, &camera, background, &[])?)
-}
-
-type Frames = (Vec<Vec<Vec3>>, Vec<[u32; 3]>);
-
-fn load_frames(input: &Path) -> Result<Frames, Error> {
-    let ext = |e: &str| input.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
-    if input.is_dir() || ext("npy") || ext("glb") || ext("gltf") {
-        if let Ok((anim, _)) = meshio::load_animation(input, &meshio::AnimationOptions::default()) {
-            if !anim.triangles.is_empty() {
-                return Ok((anim.frames, anim.triangles));
-            }
-            return Err(invalid(
-                input,
-                "an .npy animation has no triangles; pass a mesh as the input instead".to_owned(),
-            ));
-        }
-    }
-    let (mesh, _) = meshio::load_mesh(input, &meshio::LoadOptions::default())?;
-    Ok((vec![mesh.positions], mesh.triangles))
-}
-
-/// The exposure multiplier that maps the 90th percentile of the luminance of `c` over used
-/// vertices (non-zero normal) to [`AUTO_EXPOSURE_KEY`]; 1 when no vertex is lit.
-fn auto_exposure(c: &[Vec3], normals: &[Vec3]) -> f32 {
-    let lum = c
-        .iter()
-        .zip(normals)
-        .filter(|(_, n)| **n != Vec3::ZERO)
-        .map(|(v, _)| render::tone::luminance(v.to_array()));
-    render::tone::auto_exposure_ev(
-        lum,
-        render::tone::AUTO_EXPOSURE_PERCENTILE,
-        AUTO_EXPOSURE_KEY,
-    )
-    .map_or(1.0, f32::exp2)
 }
 
 /// Linear display colours: radiance scaled so that the 90th percentile of luminance is 0.8,
@@ -612,7 +501,7 @@ fn write_ply(
     colours: &[Vec3],
     ambient: &[f32],
 ) -> Result<(), Error> {
-    meshio::write_atomic(path, |w| {
+    atomic_out::write_with(path, |w| {
         write!(
             w,
             "ply\nformat binary_little_endian 1.0\ncomment cloth-vis visibility: ao = a_i (NaN: vertex used by no face)\n\
@@ -646,4 +535,109 @@ fn write_ply(
         Ok(())
     })?;
     Ok(())
+}
+
+/// `cloth-vis visibility`: the flags of a [`VisibilityRequest`].
+#[derive(clap::Args)]
+pub struct VisibilityArgs {
+    /// A mesh (.ply .obj .gltf .glb) or an animation (folder of numbered .obj, .npy, .glb).
+    input: PathBuf,
+    /// Lightsphere level s (k = 2 + 4^(s+1) directions).
+    #[arg(long, default_value_t = 3)]
+    level: u32,
+    /// Backend: depth (GPU depth maps), query (the published per-vertex occlusion
+    /// queries; slow, N·k draws) or cpu (exact ray casting); default depth on a hardware
+    /// GPU, cpu otherwise.
+    #[arg(long, value_parser = ["depth", "query", "cpu"])]
+    backend: Option<String>,
+    /// Depth-map side for the depth and query backends.
+    #[arg(long, default_value_t = occlusion_gpu::DEFAULT_DEPTH_RESOLUTION)]
+    depth_res: u32,
+    /// HDR environment (.hdr/.exr) for the colours of a .ply/.glb output and --render
+    /// (without --env or --sky: the grey ambient term a_i).
+    #[arg(long, conflicts_with = "sky")]
+    env: Option<PathBuf>,
+    /// Use the procedural sky as the environment (see --env).
+    #[arg(long)]
+    sky: bool,
+    /// Rotate the environment by DEG degrees about +Y relative to the object (rotated
+    /// look-ups of I_j; M is not recomputed). Needs --env or --sky.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    env_rotation: f32,
+    /// Output: .npy (a_i as f32 [N] or [F, N]; M as [N, k] or [F, N, k] with --matrix),
+    /// .ply (one frame: colour, float `ao` = a_i, NaN for unused vertices) or .glb (one
+    /// frame: linear float COLOR_0, float `_AO` = a_i, -1 for unused vertices).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write the matrix M instead of a_i (.npy only).
+    #[arg(long)]
+    matrix: bool,
+    /// Frames A..B of an animation (end exclusive).
+    #[arg(long, value_parser = super::parse::range)]
+    frames: Option<(usize, usize)>,
+    /// Render the last frame with its vertex radiance: FILE.png (tone-mapped) or FILE.exr
+    /// (linear HDR). Needs a GPU adapter (lavapipe is fine).
+    #[arg(long, value_name = "FILE")]
+    render: Option<PathBuf>,
+    /// PNG exposure in stops (multiplier 2^EV); default: auto (the 90th percentile of the
+    /// object's pixel luminance maps to 0.8).
+    #[arg(long, value_name = "EV", allow_negative_numbers = true)]
+    exposure: Option<f32>,
+    /// PNG display gamma.
+    #[arg(long, value_name = "G", default_value_t = DEFAULT_GAMMA)]
+    gamma: f32,
+    /// Rendered image size.
+    #[arg(long, value_name = "WxH", value_parser = super::parse::size, default_value = DEFAULT_RENDER_SIZE)]
+    render_size: [u32; 2],
+}
+
+impl VisibilityArgs {
+    /// Load the environment the flags name, compute, write; print the summary line.
+    pub fn run(self) -> anyhow::Result<()> {
+        let environment = match (&self.env, self.sky) {
+            (Some(path), _) => Some(lightsphere::Environment::load(path)?),
+            (None, true) => {
+                let s = synth::sky(&synth::SkyParams::default())?;
+                Some(lightsphere::Environment::from_latlong(
+                    s.width, s.height, s.texels,
+                )?)
+            }
+            (None, false) => None,
+        };
+        let backend = self.backend.as_deref().map(|b| match b {
+            "cpu" => Backend::Cpu,
+            "query" => Backend::Query,
+            _ => Backend::Depth,
+        });
+        let gpu = match backend {
+            Some(Backend::Cpu) if self.render.is_none() => None,
+            // A GPU backend without an adapter fails here, with gpu-context's advice.
+            Some(Backend::Depth | Backend::Query) => {
+                Some(GpuContext::new(&gpu_context::GpuOptions::default())?)
+            }
+            // --render without an adapter is refused by run_visibility, naming the flag.
+            _ => super::optional_gpu(),
+        };
+        let request = VisibilityRequest {
+            input: self.input,
+            level: self.level,
+            backend,
+            depth_resolution: self.depth_res,
+            environment,
+            env_rotation_deg: self.env_rotation,
+            out: self.out,
+            matrix: self.matrix,
+            frames: self.frames,
+            render: self.render,
+            exposure_ev: self.exposure,
+            gamma: self.gamma,
+            render_size: self.render_size,
+        };
+        super::print_line(&run_visibility(&request, gpu.as_ref())?.line())
+    }
 }

@@ -34,6 +34,14 @@ use serde::Deserialize;
 
 use crate::{Effect, Error};
 
+mod btf_table;
+mod output;
+
+pub use btf_table::BtfDesc;
+pub use output::{
+    AutoKeyword, BackgroundDesc, BackgroundKeyword, ExposureDesc, GroundDesc, OutputDesc, ToneDesc,
+};
+
 /// Prefix of procedural sources in scene files.
 pub const SYNTH_PREFIX: &str = "synth:";
 /// Largest lightsphere level a scene may ask for (k = 2 + 4^8 = 65,538 directions).
@@ -273,13 +281,13 @@ pub struct CameraDesc {
 }
 
 fn default_view_direction() -> [f32; 3] {
-    [0.55, 0.45, 1.0]
+    render::camera::DEFAULT_VIEW_DIRECTION.to_array()
 }
 fn default_up() -> [f32; 3] {
     [0.0, 1.0, 0.0]
 }
 fn default_fov() -> f32 {
-    35.0
+    render::camera::DEFAULT_FOV_Y_DEG
 }
 fn default_side() -> u32 {
     768
@@ -299,186 +307,6 @@ impl Default for CameraDesc {
     }
 }
 
-/// Exposure: stops (EV; radiance is multiplied by 2^EV before the tone curve), or `"auto"`
-/// (the 90th percentile of the objects' pixel luminance — never the backdrop's — maps to 0.8).
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, serde::Serialize)]
-#[serde(untagged)]
-pub enum ExposureDesc {
-    /// A fixed exposure in EV.
-    Fixed(f32),
-    /// `"auto"`.
-    Auto(AutoKeyword),
-}
-
-/// The keyword `auto`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum AutoKeyword {
-    /// Automatic exposure.
-    Auto,
-}
-
-/// What is drawn behind the objects: `"environment"` (default; black without one),
-/// `"black"`, `"transparent"` (PNG and EXR carry the objects' coverage as alpha), or a linear
-/// colour `[r, g, b]`.
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, serde::Serialize)]
-#[serde(untagged, try_from = "BackgroundText")]
-pub enum BackgroundDesc {
-    /// A keyword.
-    Named(BackgroundKeyword),
-    /// A constant linear colour.
-    Color([f32; 3]),
-}
-
-/// What a scene file may write for `background`, before the keyword is checked (so that a
-/// misspelt keyword gets a message listing the choices, not serde's "no variant matched").
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum BackgroundText {
-    Text(String),
-    Color([f32; 3]),
-}
-
-impl TryFrom<BackgroundText> for BackgroundDesc {
-    type Error = String;
-    fn try_from(raw: BackgroundText) -> Result<Self, String> {
-        match raw {
-            BackgroundText::Color(c) => Ok(Self::Color(c)),
-            BackgroundText::Text(t) => match t.as_str() {
-                "environment" => Ok(Self::ENVIRONMENT),
-                "black" => Ok(Self::BLACK),
-                "transparent" => Ok(Self::TRANSPARENT),
-                other => Err(format!(
-                    "background {other:?} is not one of \"environment\", \"black\",                      \"transparent\" or a linear colour [r, g, b]"
-                )),
-            },
-        }
-    }
-}
-
-impl Default for BackgroundDesc {
-    fn default() -> Self {
-        Self::Named(BackgroundKeyword::Environment)
-    }
-}
-
-impl BackgroundDesc {
-    /// The environment as the backdrop.
-    pub const ENVIRONMENT: Self = Self::Named(BackgroundKeyword::Environment);
-    /// Black.
-    pub const BLACK: Self = Self::Named(BackgroundKeyword::Black);
-    /// Transparent (alpha matte).
-    pub const TRANSPARENT: Self = Self::Named(BackgroundKeyword::Transparent);
-}
-
-/// The background keywords.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum BackgroundKeyword {
-    /// The environment map as seen by the camera.
-    Environment,
-    /// Black, opaque.
-    Black,
-    /// Nothing: alpha 0.
-    Transparent,
-}
-
-/// The tone curve of the PNG output (`render::tone`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ToneDesc {
-    /// Narkowicz's ACES fit, then sRGB (default).
-    #[default]
-    Aces,
-    /// The seed's clamp then x^(1/gamma).
-    Clamp,
-}
-
-/// An optional ground plane under the scene: a real object that receives and casts
-/// visibility like any other (`render::ground`).
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GroundDesc {
-    /// Diffuse albedo (linear RGB in [0, 1]).
-    #[serde(default = "default_ground_albedo")]
-    pub albedo: [f32; 3],
-    /// Side of the square as a multiple of the scene's bounding-sphere radius.
-    #[serde(default = "default_ground_size")]
-    pub size: f32,
-    /// Grid cells per side (the resolution of the shadows it receives per vertex).
-    #[serde(default = "default_ground_cells")]
-    pub cells: u32,
-}
-
-fn default_ground_albedo() -> [f32; 3] {
-    [0.5, 0.5, 0.5]
-}
-fn default_ground_size() -> f32 {
-    5.0
-}
-fn default_ground_cells() -> u32 {
-    64
-}
-
-/// Image outputs, written into the output folder.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OutputDesc {
-    /// PNG file name (tone-mapped), or omitted for none.
-    #[serde(default = "default_png")]
-    pub png: Option<String>,
-    /// EXR file name (linear radiance), or omitted for none.
-    #[serde(default = "default_exr")]
-    pub exr: Option<String>,
-    /// Exposure multiplier or `"auto"`.
-    #[serde(default = "default_exposure")]
-    pub exposure: ExposureDesc,
-    /// Display gamma.
-    #[serde(default = "default_gamma")]
-    pub gamma: f32,
-    /// Background.
-    #[serde(default)]
-    pub background: BackgroundDesc,
-    /// Tone curve.
-    #[serde(default)]
-    pub tone: ToneDesc,
-    /// A frame range `"A..B"` of the scene's animated objects, rendered to a numbered
-    /// sequence `frame-0000.png`, … (`png`/`exr` name the still when omitted).
-    #[serde(default)]
-    pub frames: Option<String>,
-    /// Also write `frame-NNNN.exr` for each frame of a sequence.
-    #[serde(default)]
-    pub sequence_exr: bool,
-}
-
-fn default_png() -> Option<String> {
-    Some("render.png".to_owned())
-}
-fn default_exr() -> Option<String> {
-    Some("render.exr".to_owned())
-}
-fn default_exposure() -> ExposureDesc {
-    ExposureDesc::Auto(AutoKeyword::Auto)
-}
-fn default_gamma() -> f32 {
-    2.2
-}
-
-impl Default for OutputDesc {
-    fn default() -> Self {
-        Self {
-            png: default_png(),
-            exr: default_exr(),
-            exposure: default_exposure(),
-            gamma: default_gamma(),
-            background: BackgroundDesc::default(),
-            tone: ToneDesc::default(),
-            frames: None,
-            sequence_exr: false,
-        }
-    }
-}
-
 /// Where an object's geometry comes from.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum GeometrySource {
@@ -488,73 +316,6 @@ pub enum GeometrySource {
     SynthClothObstacle,
     /// A mesh or animation file or folder.
     File(PathBuf),
-}
-
-/// The BTF material of the `btf` effect (thesis §5.3–5.5).
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct BtfDesc {
-    /// `synth:woven` (the woven-cloth BTF, compressed in memory) or a `.btfpca` file.
-    #[serde(default = "default_btf_source")]
-    pub source: String,
-    /// Objects that wear it, by name (default: every object with texture coordinates).
-    #[serde(default)]
-    pub objects: Vec<String>,
-    /// Texels per side of `synth:woven`.
-    #[serde(default = "default_btf_res")]
-    pub res: usize,
-    /// Eigen-normtextures per view slot for `synth:woven`.
-    #[serde(default = "default_btf_components")]
-    pub components: usize,
-    /// World-space direction towards the (directional) light.
-    #[serde(default = "default_btf_light_dir")]
-    pub light_dir: [f32; 3],
-    /// Linear RGB radiance g of the light (eq. 5.4).
-    #[serde(default = "default_btf_radiance")]
-    pub radiance: [f32; 3],
-    /// Texture repeats across the object's UV range.
-    #[serde(default = "default_btf_uv_scale")]
-    pub uv_scale: f32,
-    /// The picture: the BTF on the left, plain texture mapping on the right.
-    #[serde(default = "default_btf_png")]
-    pub png: String,
-}
-
-fn default_btf_source() -> String {
-    "synth:woven".to_owned()
-}
-fn default_btf_res() -> usize {
-    32
-}
-fn default_btf_components() -> usize {
-    btf::DEFAULT_COMPONENTS
-}
-fn default_btf_light_dir() -> [f32; 3] {
-    [0.4, 0.8, 0.45]
-}
-fn default_btf_radiance() -> [f32; 3] {
-    [1.0, 1.0, 1.0]
-}
-fn default_btf_uv_scale() -> f32 {
-    6.0
-}
-fn default_btf_png() -> String {
-    "btf.png".to_owned()
-}
-
-impl Default for BtfDesc {
-    fn default() -> Self {
-        Self {
-            source: default_btf_source(),
-            objects: Vec::new(),
-            res: default_btf_res(),
-            components: default_btf_components(),
-            light_dir: default_btf_light_dir(),
-            radiance: default_btf_radiance(),
-            uv_scale: default_btf_uv_scale(),
-            png: default_btf_png(),
-        }
-    }
 }
 
 /// Where the BTF material comes from.
@@ -588,6 +349,34 @@ impl Scene {
         })?;
         scene.base_dir = base_dir.to_owned();
         scene.origin = origin.to_owned();
+        Ok(scene)
+    }
+
+    /// A scene of one object read from `path` (a mesh, or an animation posed at frame 0),
+    /// one-sided, white (ρ = 1), every other table at its default: what `cloth-vis
+    /// visibility` runs through the stages. Callers set the tables they need.
+    ///
+    /// # Errors
+    /// [`Error::Request`] when `path` is not valid UTF-8 (scene sources are text).
+    pub fn one_object(path: &Path, origin: &str) -> Result<Self, Error> {
+        let source = path.to_str().ok_or_else(|| Error::Request {
+            path: path.to_owned(),
+            message: "the path is not valid UTF-8; rename the file".to_owned(),
+        })?;
+        let mut scene = Self::from_toml("", Path::new(""), origin)?;
+        scene.name = path
+            .file_name()
+            .map_or_else(|| source.to_owned(), |n| n.to_string_lossy().into_owned());
+        scene.objects.push(ObjectDesc {
+            name: scene.name.clone(),
+            source: source.to_owned(),
+            frame: 0,
+            albedo: [1.0; 3],
+            two_sided: false,
+            translation: [0.0; 3],
+            rotation_deg: [0.0; 3],
+            scale: 1.0,
+        });
         Ok(scene)
     }
 

@@ -3,18 +3,16 @@
 //! `stats` prints the library's numbers, and bad input (a corrupt file, an unsupported output,
 //! mismatched counts) is refused with the file named and nothing written.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use anim_pca::compress::{Compressed, Decoder, bpvf_from_file};
-use cloth_vis::anim_compress_cmd::{
+use crate::commands::cpca::{
     CompressRequest, DEFAULT_K_MAX, DecompressRequest, run_compress, run_decompress, run_stats,
 };
+use anim_pca::compress::{Compressed, Decoder, bpvf_from_file};
 use glam::Vec3;
 
-use common::{cli, text};
+use super::common::{cli, text};
 
 const VERTICES: usize = 64;
 const FRAMES: usize = 40;
@@ -506,14 +504,13 @@ fn stats_draws_the_error_per_frame_and_the_clusters() {
 
     let Some(gpu) = gpu() else { return };
     // The npy clip has no triangles: a cluster picture of it is refused by name.
-    let request = cloth_vis::anim_compress_cmd::StatsRequest {
+    let request = crate::commands::cpca::StatsRequest {
         original: input.clone(),
         cpca: cpca.clone(),
         clusters_png: Some(dir.path().join("clusters.png")),
         error_plot: None,
     };
-    let e =
-        cloth_vis::anim_compress_cmd::run_stats_with_pictures(&request, Some(&gpu)).unwrap_err();
+    let e = crate::commands::cpca::run_stats_with_pictures(&request, Some(&gpu)).unwrap_err();
     assert!(e.to_string().contains("triangles"), "{e}");
     assert!(!dir.path().join("clusters.png").exists());
     // With triangles: two ribbons (the bars given a width along z, so that their triangles
@@ -546,10 +543,9 @@ fn stats_draws_the_error_per_frame_and_the_clusters() {
     )
     .unwrap();
     let image =
-        cloth_vis::anim_compress_cmd::cluster_strip(&gpu, &packed, Path::new("clusters.png"))
-            .unwrap();
+        crate::commands::cpca::cluster_strip(&gpu, &packed, Path::new("clusters.png")).unwrap();
     // Count distinct hues among lit pixels: background plus one per cluster at least.
-    let colours = cloth_vis::strip::label_colours(2);
+    let colours = figures::strip::label_colours(2);
     let hue = |c: glam::Vec3| (c.x - c.z).signum();
     assert_ne!(
         hue(colours[0]),

@@ -4,8 +4,10 @@
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
+use crate::commands::jumpmap::{
+    JumpMapRequest, PlayControl, StripRequest, parse_cell_at, run_jumpmap,
+};
 use anim_pca::{Blend, JumpMapParams, PlaybackParams};
-use cloth_vis::anim_cmd::{JumpMapRequest, PlayControl, StripRequest, parse_cell_at, run_jumpmap};
 use glam::Vec3;
 use gpu_context::{GpuContext, GpuOptions};
 

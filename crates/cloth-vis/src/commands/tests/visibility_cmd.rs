@@ -1,8 +1,8 @@
 //! `cloth-vis visibility` end to end on the cpu backend (no GPU needed): array shapes, NaN for
 //! vertices used by no face, a PLY that our own loader reads back, and refusals before work.
 
+use crate::commands::visibility::{VisibilityRequest, run_visibility};
 use cloth_vis::Error;
-use cloth_vis::visibility_cmd::{VisibilityRequest, run_visibility};
 
 /// A 5×5 grid facing +y, plus one vertex used by no face (index 25).
 fn grid_obj(dir: &std::path::Path) -> std::path::PathBuf {

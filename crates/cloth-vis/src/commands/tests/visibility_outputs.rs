@@ -4,11 +4,13 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::commands::visibility::{GLB_UNUSED_AO, VisibilityRequest, run_visibility};
 use cloth_vis::camera::resolve;
-use cloth_vis::scene::CameraDesc;
-use cloth_vis::visibility_cmd::{
-    GLB_UNUSED_AO, VisibilityRequest, env_rotation, light_radiance, run_visibility, vertex_radiance,
+use cloth_vis::lighting::{
+    environment_rotation as env_rotation, rotated_lookup_radiance as light_radiance,
+    shadowed_radiance as vertex_radiance,
 };
+use cloth_vis::scene::CameraDesc;
 use glam::Vec3;
 use gpu_context::{GpuContext, GpuOptions};
 use lightsphere::{Environment, Lightsphere, RadianceMethod};

@@ -1,0 +1,31 @@
+//! The subcommands of `cloth-vis`, one file each with its clap arguments. They are private to
+//! the binary: the library (`cloth_vis`) offers scenes, stages and the run; these files turn
+//! flags into requests, check them before any work, and print one summary line.
+
+pub mod anim;
+pub mod btf;
+pub mod cpca;
+pub mod inspect;
+pub mod jumpmap;
+pub mod parse;
+pub mod render;
+pub mod visibility;
+
+#[cfg(test)]
+mod tests;
+
+use std::io::Write as _;
+
+use gpu_context::{GpuContext, GpuOptions};
+
+/// A GPU context when an adapter exists; commands that need one refuse the request with a
+/// message naming the flag (and the software driver to install) when it is `None`.
+pub fn optional_gpu() -> Option<GpuContext> {
+    GpuContext::new(&GpuOptions::default()).ok()
+}
+
+/// Print a command's one summary line on stdout.
+pub fn print_line(line: &str) -> anyhow::Result<()> {
+    writeln!(std::io::stdout().lock(), "{line}")?;
+    Ok(())
+}

@@ -1,0 +1,9 @@
+//! Tests of the subcommands' requests (their checks before work, their outputs against
+//! library and closed-form references) and, through the built binary, of their flags.
+
+mod common;
+
+mod anim_compress;
+mod anim_jumpmap;
+mod visibility_cmd;
+mod visibility_outputs;
