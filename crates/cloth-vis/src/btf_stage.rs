@@ -16,7 +16,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use btf::render::{BtfMesh, GpuBtfRenderer, Light, RenderParams, RenderedImage};
+use btf::render::{BtfMesh, GpuBtfRenderer, Light, RenderParams};
 use btf::{BtfPca, BtfPcaParams, Sampling, ViewSlot};
 use glam::{Vec2, Vec3, Vec4};
 use gpu_context::{GpuContext, HdrImage};
@@ -89,63 +89,6 @@ pub fn plain_material(pca: &BtfPca) -> Result<BtfPca, Error> {
     Ok(BtfPca::compress_with(s, w, h, &params, load, None)?.0)
 }
 
-/// A rendered image: linear RGB and which pixels some object covers.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Layer {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Linear RGB, row-major, top row first.
-    pub pixels: Vec<[f32; 3]>,
-    /// Whether an object covers the pixel.
-    pub covered: Vec<bool>,
-}
-
-impl Layer {
-    /// A read-back frame: covered where alpha > ½.
-    fn from_hdr(image: &HdrImage) -> Self {
-        Self {
-            width: image.width(),
-            height: image.height(),
-            pixels: image.pixels().iter().map(|p| [p[0], p[1], p[2]]).collect(),
-            covered: image.pixels().iter().map(|p| p[3] > 0.5).collect(),
-        }
-    }
-
-    fn from_image(image: &RenderedImage) -> Self {
-        Self {
-            width: image.width(),
-            height: image.height(),
-            pixels: image.pixels().to_vec(),
-            covered: image.coverage().to_vec(),
-        }
-    }
-
-    /// Draws `image` over this layer where it covers pixels.
-    fn over(&mut self, image: &RenderedImage) {
-        for ((p, c), (q, d)) in self
-            .pixels
-            .iter_mut()
-            .zip(self.covered.iter_mut())
-            .zip(image.pixels().iter().zip(image.coverage()))
-        {
-            if *d {
-                *p = *q;
-                *c = true;
-            }
-        }
-    }
-
-    /// 8-bit sRGB (clamped to [0, 1] first).
-    pub fn to_srgb8(&self) -> Vec<[u8; 3]> {
-        self.pixels
-            .iter()
-            .map(|p| p.map(|c| btf::linear_to_srgb8(c.clamp(0.0, 1.0))))
-            .collect()
-    }
-}
-
 /// The tangent frames of `object` (it needs UVs).
 fn tangents_of(object: &WorldObject) -> Result<(Vec<Vec4>, &[Vec2]), Error> {
     let uvs = object.uvs.as_deref().ok_or_else(|| Error::Request {
@@ -181,7 +124,7 @@ pub fn render_objects(
     light: &Light,
     camera: &Camera,
     params: &RenderParams,
-) -> Result<Layer, Error> {
+) -> Result<HdrImage, Error> {
     if objects.is_empty() {
         return Err(Error::Request {
             path: PathBuf::from("btf.objects"),
@@ -203,41 +146,54 @@ pub fn render_objects(
         let passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
         let background = Background::Color(params.background.to_array());
         let image = renderer.render(&g.device, &g.queue, camera, background, &passes)?;
-        return Ok(Layer::from_hdr(&image));
+        return Ok(image);
     }
-    let mut result: Option<Layer> = None;
+    // The CPU reference: each object over the previous where it covers pixels.
+    let mut result: Option<Vec<[f32; 4]>> = None;
     for (object, (tangents, uvs)) in objects.iter().zip(&frames) {
         let mesh = btf_mesh(object, tangents, uvs);
-        let image = btf::render::render_cpu(pca, &mesh, light, camera, params)?;
+        let image = btf::render::render_cpu(pca, &mesh, light, camera, params)?.to_rgba();
         match &mut result {
-            None => result = Some(Layer::from_image(&image)),
-            Some(below) => below.over(&image),
+            None => result = Some(image),
+            Some(below) => {
+                for (b, p) in below.iter_mut().zip(image) {
+                    if p[3] > 0.0 {
+                        *b = p;
+                    }
+                }
+            }
         }
     }
-    result.ok_or_else(|| Error::Request {
+    let pixels = result.ok_or_else(|| Error::Request {
         path: PathBuf::from("btf.objects"),
         message: "no object to draw with the BTF".to_owned(),
-    })
+    })?;
+    Ok(HdrImage::new(camera.width, camera.height, pixels)?)
 }
 
-/// One image as 8-bit sRGB.
-pub fn single(image: &Layer) -> image::RgbaImage {
-    let mut out = image::RgbaImage::new(image.width, image.height);
-    for (i, p) in image.to_srgb8().iter().enumerate() {
-        let (x, y) = (i as u32 % image.width, i as u32 / image.width);
-        out.put_pixel(x, y, image::Rgba([p[0], p[1], p[2], 255]));
+/// The seed's display of a BTF render: linear radiance clamped to [0, 1], then sRGB-encoded
+/// (the normtextures are sRGB images, so a unit light shows them as measured); opaque.
+fn display() -> render::tone::Display {
+    render::tone::Display {
+        exposure_ev: 0.0,
+        curve: render::tone::ToneCurve::ClampSrgb,
     }
-    out
 }
 
-/// Two images side by side, as 8-bit sRGB.
-pub fn side_by_side(left: &Layer, right: &Layer) -> image::RgbaImage {
-    let (w, h) = (left.width, left.height);
-    let mut out = image::RgbaImage::new(2 * w, h);
-    for (x0, img) in [(0, left), (w, right)] {
-        for (i, p) in img.to_srgb8().iter().enumerate() {
-            let (x, y) = (i as u32 % w, i as u32 / w);
-            out.put_pixel(x0 + x, y, image::Rgba([p[0], p[1], p[2], 255]));
+/// One image as 8-bit RGBA (see [`display`]; the background stays opaque).
+pub fn single(image: &HdrImage) -> image::RgbaImage {
+    let rgba = render::output::to_rgba8(image, &display(), Background::Color([0.0; 3]));
+    image::RgbaImage::from_raw(image.width(), image.height(), rgba)
+        .unwrap_or_else(|| image::RgbaImage::new(image.width(), image.height()))
+}
+
+/// Two images of one size side by side, as 8-bit RGBA.
+pub fn side_by_side(left: &HdrImage, right: &HdrImage) -> image::RgbaImage {
+    let (l, r) = (single(left), single(right));
+    let mut out = image::RgbaImage::new(l.width() + r.width(), l.height().max(r.height()));
+    for (x0, img) in [(0, &l), (l.width(), &r)] {
+        for (x, y, p) in img.enumerate_pixels() {
+            out.put_pixel(x0 + x, y, *p);
         }
     }
     out

@@ -63,6 +63,9 @@ pub enum ToneCurve {
         /// Display gamma (2.2 in the seed).
         gamma: f32,
     },
+    /// Clamp to [0, 1], then the sRGB encoding: for renders of measured sRGB data (BTF
+    /// normtextures), so that a unit light shows the material as it was photographed.
+    ClampSrgb,
 }
 
 /// Exposure and tone curve: linear radiance to display values.
@@ -89,6 +92,7 @@ impl Display {
                 let v = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
                 v.powf(1.0 / gamma)
             }
+            ToneCurve::ClampSrgb => srgb_encode(if x.is_nan() { 0.0 } else { x }),
         }
     }
 
@@ -183,6 +187,16 @@ mod tests {
         assert_eq!(seed.map_u8(0.5), 186);
         assert_eq!(seed.map_u8(1e9), 255);
         assert_eq!(seed.map_u8(f32::NAN), 0);
+        // The BTF display: the sRGB code of the clamped value, NaN black.
+        let srgb = Display {
+            exposure_ev: 0.0,
+            curve: ToneCurve::ClampSrgb,
+        };
+        assert_eq!(srgb.map_u8(0.5), 188); // 0.735357 · 255 = 187.5 → 188
+        assert_eq!(srgb.map_u8(0.002), 7); // 12.92 · 0.002 · 255 = 6.59 → 7
+        assert_eq!(srgb.map_u8(1e9), 255);
+        assert_eq!(srgb.map_u8(-1.0), 0);
+        assert_eq!(srgb.map_u8(f32::NAN), 0);
     }
 
     #[test]

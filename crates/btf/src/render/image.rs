@@ -33,6 +33,17 @@ impl RenderedImage {
         }
     }
 
+    /// Linear RGBA pixels, row-major, top row first, alpha 1 where a triangle covers the
+    /// pixel and 0 elsewhere: the layout of the workspace's linear image
+    /// (`gpu_context::HdrImage::new(width, height, image.to_rgba())`).
+    pub fn to_rgba(&self) -> Vec<[f32; 4]> {
+        self.pixels
+            .iter()
+            .zip(&self.coverage)
+            .map(|(p, &c)| [p[0], p[1], p[2], if c { 1.0 } else { 0.0 }])
+            .collect()
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> u32 {
         self.width

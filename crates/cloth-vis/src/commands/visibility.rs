@@ -540,7 +540,8 @@ fn write_ply(
 /// `cloth-vis visibility`: the flags of a [`VisibilityRequest`].
 #[derive(clap::Args)]
 pub struct VisibilityArgs {
-    /// A mesh (.ply .obj .gltf .glb) or an animation (folder of numbered .obj, .npy, .glb).
+    /// A mesh (.ply .obj .gltf .glb), an animation (folder of numbered .obj, .npy, .glb) or
+    /// synth:cloth (the demo's simulated drape).
     input: PathBuf,
     /// Lightsphere level s (k = 2 + 4^(s+1) directions).
     #[arg(long, default_value_t = 3)]
