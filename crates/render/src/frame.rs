@@ -18,6 +18,8 @@ use crate::camera::Camera;
 use crate::gouraud::GouraudPass;
 use crate::output::Background;
 use crate::target::{FrameFormat, FrameTarget};
+use crate::tone::Display;
+use crate::tonemap::{DISPLAY_FORMAT, ToneMapPass};
 
 /// When a pass records, relative to the others.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -69,7 +71,11 @@ pub struct Renderer {
     view_buffer: wgpu::Buffer,
     view_group: wgpu::BindGroup,
     target: Option<FrameTarget>,
+    /// The tone-map binding of the current target's HDR colour.
+    tone_group: Option<wgpu::BindGroup>,
     frames: u64,
+    /// The GPU tone map into [`DISPLAY_FORMAT`] (the last pass, [`Renderer::render_display`]).
+    pub tonemap: ToneMapPass,
     /// The Gouraud meshes (opaque, recorded first).
     pub gouraud: GouraudPass,
     /// The environment backdrop (recorded after every depth-reading pass).
@@ -102,13 +108,16 @@ impl Renderer {
         };
         let gouraud = GouraudPass::new(device, &ctx);
         let backdrop = BackdropPass::new(device, &ctx);
+        let tonemap = ToneMapPass::new(device, DISPLAY_FORMAT);
         Self {
             format,
             view_layout,
             view_buffer,
             view_group,
             target: None,
+            tone_group: None,
             frames: 0,
+            tonemap,
             gouraud,
             backdrop,
         }
@@ -137,9 +146,10 @@ impl Renderer {
     /// Order: clear (colour to the background's colour with alpha 0, depth to the far value,
     /// stencil to 0) → Gouraud meshes → `passes` of [`Phase::Opaque`] → `passes` of
     /// [`Phase::DepthReading`] → the backdrop (only with [`Background::Environment`]) →
-    /// MSAA resolve → read-back. Tone mapping happens on the read-back image
-    /// ([`crate::output`]), so the EXR keeps linear radiance. Alpha is the objects'
-    /// coverage (a fraction of the samples at edges); background pixels have alpha 0.
+    /// MSAA resolve → read-back. The tone map is the caller's choice: on the read-back image
+    /// ([`crate::output`], so the EXR keeps linear radiance and automatic exposure can read
+    /// the objects' pixels), or on the GPU with [`Renderer::render_display`]. Alpha is the
+    /// objects' coverage (a fraction of the samples at edges); background pixels have alpha 0.
     ///
     /// # Errors
     /// [`RenderError::Camera`] for a camera that makes no image; [`RenderError::Gpu`] when
@@ -152,6 +162,74 @@ impl Renderer {
         background: Background,
         passes: &[&dyn FramePass],
     ) -> Result<HdrImage, RenderError> {
+        self.draw(device, queue, camera, background, passes)?;
+        let target = self.current_target()?;
+        Ok(read_hdr_image(device, queue, &target.resolved)?)
+    }
+
+    /// Render one frame as [`Renderer::render`] does, then tone-map it on the GPU with
+    /// `display` (the frame's last pass, [`ToneMapPass`]) and read back 8-bit RGBA, row-major,
+    /// top row first — what [`crate::output::to_rgba8`] makes of the HDR read-back, within
+    /// one code, without moving 16 bytes per pixel.
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_display(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        camera: &Camera,
+        background: Background,
+        passes: &[&dyn FramePass],
+        display: &Display,
+    ) -> Result<Vec<u8>, RenderError> {
+        self.draw(device, queue, camera, background, passes)?;
+        let target = self.current_target()?;
+        let group = self.tone_group.as_ref().ok_or_else(|| {
+            RenderError::Gpu(GpuError::Readback("tone-map binding missing".to_owned()))
+        })?;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("tone map"),
+        });
+        self.tonemap.record(
+            queue,
+            &mut encoder,
+            group,
+            display,
+            background,
+            &target.display_view,
+        );
+        queue.submit([encoder.finish()]);
+        Ok(gpu_context::read_texture(
+            device,
+            queue,
+            &target.display,
+            4,
+            wgpu::TextureAspect::All,
+        )?)
+    }
+
+    /// The resolved HDR colour of the last frame drawn (single-sample `Rgba32Float`, bindable
+    /// as a texture): what a viewer hands to its own [`ToneMapPass`] for a surface format.
+    pub fn hdr_view(&self) -> Option<&wgpu::TextureView> {
+        self.target.as_ref().map(|t| &t.resolved_view)
+    }
+
+    fn current_target(&self) -> Result<&FrameTarget, RenderError> {
+        self.target
+            .as_ref()
+            .ok_or_else(|| RenderError::Gpu(GpuError::Readback("frame target missing".to_owned())))
+    }
+
+    /// Record and submit one frame into the target (reallocated when the size changes).
+    fn draw(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        camera: &Camera,
+        background: Background,
+        passes: &[&dyn FramePass],
+    ) -> Result<(), RenderError> {
         let clip_from_world = camera.clip_from_world_with(self.format.depth)?;
         let uniform = ViewUniform {
             clip_from_world: clip_from_world.to_cols_array_2d(),
@@ -170,12 +248,9 @@ impl Renderer {
             .as_ref()
             .is_none_or(|t| t.width != camera.width || t.height != camera.height)
         {
-            self.target = Some(FrameTarget::new(
-                device,
-                &self.format,
-                camera.width,
-                camera.height,
-            )?);
+            let target = FrameTarget::new(device, &self.format, camera.width, camera.height)?;
+            self.tone_group = Some(self.tonemap.bind(device, &target.resolved_view));
+            self.target = Some(target);
         }
         let target = self.target.as_ref().ok_or_else(|| {
             RenderError::Gpu(GpuError::Readback("frame target missing".to_owned()))
@@ -237,8 +312,7 @@ impl Renderer {
             }
         }
         queue.submit([encoder.finish()]);
-        let image = read_hdr_image(device, queue, &target.resolved)?;
         self.frames += 1;
-        Ok(image)
+        Ok(())
     }
 }

@@ -19,11 +19,12 @@
 //! | 2 | other opaque passes ([`Phase::Opaque`]): BTF materials | test + write | — | effects |
 //! | 3 | passes reading depth/stencil ([`Phase::DepthReading`]): shadow volumes, translucency | test | read/write | effects |
 //! | 4 | environment backdrop, only where depth is still the far value | equal | — | [`BackdropPass`] |
-//! | 5 | MSAA resolve, read-back | | | [`Renderer`] |
-//! | 6 | exposure (EV), tone curve, sRGB, alpha: PNG; linear EXR | | | [`output`], [`tone`] |
+//! | 5 | MSAA resolve | | | [`Renderer`] |
+//! | 6 | tone map: exposure (EV), tone curve, sRGB, un-premultiplied colour + alpha | | | [`ToneMapPass`] on the GPU ([`Renderer::render_display`], a viewer's surface), or [`output`] + [`tone`] on the read-back HDR image (PNG; linear EXR) |
 //!
-//! Tone mapping runs on the CPU over the read-back image so the EXR keeps linear radiance
-//! and automatic exposure can ignore the backdrop.
+//! The two tone maps agree within one 8-bit code (tested). Files go through the CPU one so
+//! the EXR keeps linear radiance and automatic exposure can read the objects' pixels and
+//! ignore the backdrop; an interactive viewer presents the GPU one every frame.
 //!
 //! ## Joining the frame
 //!
@@ -68,6 +69,8 @@ pub mod output;
 pub mod sequence;
 #[cfg(feature = "gpu")]
 mod target;
+#[cfg(feature = "gpu")]
+mod tonemap;
 
 #[cfg(feature = "gpu")]
 pub use backdrop::{BACKDROP_SHADER, Backdrop, BackdropPass, MAX_BACKDROP_WIDTH};
@@ -82,6 +85,8 @@ pub use gouraud::{DrawMesh, GOURAUD_SHADER, GouraudPass};
 pub use output::Background;
 #[cfg(feature = "gpu")]
 pub use target::{FrameFormat, PREFERRED_SAMPLES};
+#[cfg(feature = "gpu")]
+pub use tonemap::{DISPLAY_FORMAT, TONEMAP_SHADER, ToneMapPass};
 
 /// WGSL of group 0, the view, which every pass of the frame prepends to its own shader.
 pub const VIEW_SHADER: &str = include_str!("view.wgsl");

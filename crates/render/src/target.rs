@@ -110,6 +110,10 @@ pub(crate) struct FrameTarget {
     /// One-sample colour: the render target without MSAA, the resolve target with it.
     pub resolved: wgpu::Texture,
     pub resolved_view: wgpu::TextureView,
+    /// The tone-mapped 8-bit frame ([`crate::tonemap::DISPLAY_FORMAT`]).
+    pub display: wgpu::Texture,
+    /// View of `display`.
+    pub display_view: wgpu::TextureView,
     pub depth_view: wgpu::TextureView,
     pub width: u32,
     pub height: u32,
@@ -153,6 +157,12 @@ impl FrameTarget {
             "frame colour",
             format.color,
             1,
+            attach | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let display = make(
+            "frame display",
+            crate::tonemap::DISPLAY_FORMAT,
+            1,
             attach | wgpu::TextureUsages::COPY_SRC,
         );
         let msaa_color = (format.samples > 1).then(|| {
@@ -169,6 +179,8 @@ impl FrameTarget {
             msaa_color,
             resolved_view: resolved.create_view(&Default::default()),
             resolved,
+            display_view: display.create_view(&Default::default()),
+            display,
             depth_view: depth.create_view(&Default::default()),
             width,
             height,

@@ -347,8 +347,8 @@ fn a_sequence_builds_its_pipelines_once_and_rewrites_buffers_in_place() {
     let built = PipelineStats::on_this_thread();
     assert_eq!(
         built.render_pipelines - before.render_pipelines,
-        2,
-        "gouraud + backdrop"
+        3,
+        "gouraud + backdrop + tone map"
     );
     let triangles = [[0u32, 1, 2]];
     for frame in 0..6 {
