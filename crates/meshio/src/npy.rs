@@ -279,6 +279,61 @@ pub fn write_npy_f32(path: &Path, shape: &[usize], data: &[f32]) -> Result<(), M
     Ok(())
 }
 
+/// Writes an animation as a `[F, V, 3]` f32 array, one frame at a time from `frames`, so a
+/// caller that produces frames lazily (a decoder) never holds the whole clip. The file appears
+/// complete or not at all.
+///
+/// # Errors
+/// [`MeshIoError::ShapeMismatch`] when a frame does not hold `vertex_count` positions or the
+/// iterator does not yield exactly `frame_count` frames (nothing is left behind);
+/// [`MeshIoError::Io`] naming `path` when writing fails.
+pub fn write_npy_frames<I>(
+    path: &Path,
+    frame_count: usize,
+    vertex_count: usize,
+    frames: I,
+) -> Result<(), MeshIoError>
+where
+    I: IntoIterator,
+    I::Item: AsRef<[Vec3]>,
+{
+    let shape = [frame_count, vertex_count, 3];
+    let header = npy_header(&shape);
+    let mut mismatch = None;
+    let result = atomic_out::write_with(path, |w| {
+        w.write_all(&header)?;
+        let mut written = 0usize;
+        for frame in frames {
+            let frame = frame.as_ref();
+            if frame.len() != vertex_count || written == frame_count {
+                mismatch = Some(written * vertex_count * 3 + frame.len() * 3);
+                return Err(std::io::Error::other("frame shape"));
+            }
+            for p in frame {
+                for v in p.to_array() {
+                    w.write_all(&v.to_le_bytes())?;
+                }
+            }
+            written += 1;
+        }
+        if written != frame_count {
+            mismatch = Some(written * vertex_count * 3);
+            return Err(std::io::Error::other("frame count"));
+        }
+        Ok(())
+    });
+    if let Some(actual) = mismatch {
+        return Err(MeshIoError::ShapeMismatch {
+            path: path.to_path_buf(),
+            shape: shape.to_vec(),
+            expected: frame_count.checked_mul(vertex_count * 3),
+            actual,
+        });
+    }
+    result?;
+    Ok(())
+}
+
 /// Magic, version, length and dict, padded with spaces and a newline to a multiple of 64 bytes
 /// (the alignment NumPy itself uses).
 fn npy_header(shape: &[usize]) -> Vec<u8> {
@@ -332,6 +387,22 @@ pub(crate) fn load_npy_animation(
             ),
         ));
     };
+    if frame_count == 0 || vertex_count == 0 {
+        // Checked before anything is allocated: a (2^40, 0, 3) header holds no data, and one
+        // empty Vec per frame would still take 24 bytes each (hard case C2).
+        return Err(npy_error(
+            path,
+            format!(
+                "shape {:?} has no {}; an animation needs at least one frame of one vertex",
+                array.shape,
+                if frame_count == 0 {
+                    "frames"
+                } else {
+                    "vertices"
+                }
+            ),
+        ));
+    }
     let mut report = LoadReport::new(path, SourceFormat::Npy);
     let (triangles, uvs) = match &options.topology {
         Some(topology) => {
@@ -358,20 +429,16 @@ pub(crate) fn load_npy_animation(
             (Vec::new(), None)
         }
     };
-    let frames: Vec<Vec<Vec3>> = if vertex_count == 0 {
-        vec![Vec::new(); frame_count]
-    } else {
-        array
-            .data
-            .chunks_exact(vertex_count * 3)
-            .map(|frame| {
-                frame
-                    .chunks_exact(3)
-                    .map(|p| Vec3::new(p[0], p[1], p[2]))
-                    .collect()
-            })
-            .collect()
-    };
+    let frames: Vec<Vec<Vec3>> = array
+        .data
+        .chunks_exact(vertex_count * 3)
+        .map(|frame| {
+            frame
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2]))
+                .collect()
+        })
+        .collect();
     let animation = Animation {
         triangles,
         frames,

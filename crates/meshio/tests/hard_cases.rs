@@ -259,6 +259,48 @@ fn empty_elements_with_huge_counts_are_harmless() {
 }
 
 #[test]
+fn property_less_face_element_with_a_huge_count_is_an_error_not_an_abort() {
+    // Issue #12, C1: `element face 2^40` with no property lines passed the size check (a row
+    // of no properties occupies no bytes) and then reserved 2^40 triangles.
+    let dir = tempfile::tempdir().unwrap();
+    let text = format!(
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+         property float z\nelement face 1099511627776\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+    );
+    let err = load(&write(dir.path(), "c1.ply", text)).unwrap_err();
+    let message = err.to_string();
+    assert!(message.contains("c1.ply"), "{message}");
+    assert!(message.contains("face"), "{message}");
+}
+
+fn npy_with_shape(dir: &Path, name: &str, shape: &str) -> PathBuf {
+    let dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {shape}, }}\n");
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&(dict.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(dict.as_bytes());
+    write(dir, name, bytes)
+}
+
+#[test]
+fn npy_animation_without_vertices_or_frames_is_refused_before_allocating() {
+    // Issue #12, C2: shape (2^40, 0, 3) and no data allocated one empty frame per claimed frame.
+    let dir = tempfile::tempdir().unwrap();
+    for (name, shape, what) in [
+        ("c2.npy", "(1099511627776, 0, 3)", "no vertices"),
+        ("c2b.npy", "(67108864, 0, 3)", "no vertices"),
+        ("c2c.npy", "(0, 5, 3)", "no frames"),
+    ] {
+        let path = npy_with_shape(dir.path(), name, shape);
+        let err = load_animation(&path, &AnimationOptions::default()).unwrap_err();
+        let message = err.to_string();
+        assert!(
+            message.contains(name) && message.contains(what),
+            "{message}"
+        );
+    }
+}
+
+#[test]
 fn truncated_binary_ply_names_offset_and_length() {
     let dir = tempfile::tempdir().unwrap();
     let full = ply_binary(

@@ -196,3 +196,52 @@ fn chicken_round_trips_through_npy() {
     let (back, _) = load_animation(&path, &options).unwrap();
     assert_eq!(back, anim);
 }
+
+#[test]
+fn streamed_frames_equal_the_whole_array_and_a_wrong_stream_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames: Vec<Vec<Vec3>> = (0..4)
+        .map(|f| {
+            (0..5)
+                .map(|v| Vec3::new(f as f32, v as f32, -0.5 * (f * v) as f32))
+                .collect()
+        })
+        .collect();
+    // Lazily produced frames, as a decoder yields them.
+    let streamed = dir.path().join("streamed.npy");
+    meshio::write_npy_frames(&streamed, 4, 5, (0..4).map(|f| frames[f].clone())).unwrap();
+    let whole = dir.path().join("whole.npy");
+    let flat: Vec<f32> = frames.iter().flatten().flat_map(|p| p.to_array()).collect();
+    write_npy_f32(&whole, &[4, 5, 3], &flat).unwrap();
+    assert_eq!(
+        std::fs::read(&streamed).unwrap(),
+        std::fs::read(&whole).unwrap()
+    );
+    let back = load_animation(&streamed, &AnimationOptions::default())
+        .unwrap()
+        .0;
+    assert_eq!(back.frames, frames);
+
+    // Too few frames, too many, and a short frame: an error naming the file, and no file.
+    for (name, count, cut) in [("few.npy", 5, 5), ("many.npy", 3, 5), ("short.npy", 4, 4)] {
+        let path = dir.path().join(name);
+        let stream = frames.iter().enumerate().map(|(f, frame)| {
+            if f == 2 {
+                frame[..cut].to_vec()
+            } else {
+                frame.clone()
+            }
+        });
+        let err = meshio::write_npy_frames(&path, count, 5, stream).unwrap_err();
+        assert!(
+            matches!(err, MeshIoError::ShapeMismatch { .. }) && err.to_string().contains(name),
+            "{err}"
+        );
+        assert!(!path.exists(), "{name} was left behind");
+    }
+    let names: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 2, "only the two good files: {names:?}");
+}

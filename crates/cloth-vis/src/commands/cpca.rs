@@ -294,6 +294,7 @@ pub fn read_cpca(path: &Path) -> Result<(Compressed, usize), Error> {
 /// write errors naming the output.
 pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error> {
     check_cpca_out(&request.out)?;
+    super::refuse_overwriting_input(&request.out, &[&request.input])?;
     let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
     let start = Instant::now();
     let (packed, search) = match request.target {
@@ -353,6 +354,7 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
 /// naming the output. Nothing is written on error.
 pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, Error> {
     let kind = out_kind(&request.out)?;
+    super::refuse_overwriting_input(&request.out, &[&request.input])?;
     let (data, _) = read_cpca(&request.input)?;
     if kind == OutKind::Glb && data.triangles().is_empty() {
         return Err(invalid(
@@ -363,15 +365,39 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
         ));
     }
     let start = Instant::now();
-    let frames = Decoder::new(&data).decode_all();
-    let decode_seconds = start.elapsed().as_secs_f64();
-    write_frames(
-        &request.out,
-        kind,
-        frames,
-        data.triangles(),
-        data.frame_rate(),
-    )?;
+    let decoder = Decoder::new(&data);
+    let decode_seconds = if kind == OutKind::Npy {
+        // Streamed: one frame decoded, written, dropped (peak memory O(V), not 2·F·V).
+        let mut scratch = decoder.scratch();
+        let mut failure = None;
+        let mut decoding = std::time::Duration::ZERO;
+        let frames = (0..decoder.frames()).map(|f| {
+            let mut out = vec![Vec3::ZERO; decoder.vertices()];
+            let t = Instant::now();
+            if let Err(e) = decoder.frame_into(f, &mut out, &mut scratch) {
+                failure.get_or_insert(e);
+            }
+            decoding += t.elapsed();
+            out
+        });
+        meshio::write_npy_frames(&request.out, decoder.frames(), decoder.vertices(), frames)?;
+        if let Some(e) = failure {
+            let _ = std::fs::remove_file(&request.out);
+            return Err(anim_error(&request.input, e));
+        }
+        decoding.as_secs_f64()
+    } else {
+        let frames = decoder.decode_all();
+        let seconds = start.elapsed().as_secs_f64();
+        write_frames(
+            &request.out,
+            kind,
+            frames,
+            data.triangles(),
+            data.frame_rate(),
+        )?;
+        seconds
+    };
     Ok(DecompressSummary {
         vertices: data.vertices(),
         frames: data.frames(),
@@ -544,11 +570,7 @@ fn write_frames(
     match kind {
         OutKind::Npy => {
             let vertices = frames.first().map_or(0, Vec::len);
-            let data: Vec<f32> = frames
-                .iter()
-                .flat_map(|f| f.iter().flat_map(|v| v.to_array()))
-                .collect();
-            meshio::write_npy_f32(out, &[frames.len(), vertices, 3], &data)?;
+            meshio::write_npy_frames(out, frames.len(), vertices, &frames)?;
         }
         OutKind::Glb => {
             let animation = meshio::Animation {

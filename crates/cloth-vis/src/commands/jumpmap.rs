@@ -141,6 +141,10 @@ pub fn run_jumpmap(
     gpu: Option<&GpuContext>,
 ) -> Result<JumpMapSummary, Error> {
     let out = &request.out;
+    let inputs: Vec<&Path> = std::iter::once(request.input.as_path())
+        .chain(request.control.cells.iter().map(PathBuf::as_path))
+        .collect();
+    super::refuse_overwriting_input(out, &inputs)?;
     let kind = match out
         .extension()
         .and_then(|e| e.to_str())

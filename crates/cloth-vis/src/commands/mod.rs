@@ -24,6 +24,34 @@ pub fn optional_gpu() -> Option<GpuContext> {
     GpuContext::new(&GpuOptions::default()).ok()
 }
 
+/// Refuses an output path that names an input (the same file, however spelled: through
+/// `..`, a symlink or a hard link), before any work — `visibility bunny.ply --out bunny.ply`
+/// would otherwise overwrite the mesh it reads.
+///
+/// # Errors
+/// [`cloth_vis::Error::Request`] naming the output and the input.
+pub fn refuse_overwriting_input(
+    output: &std::path::Path,
+    inputs: &[&std::path::Path],
+) -> Result<(), cloth_vis::Error> {
+    let Ok(out) = std::fs::canonicalize(output) else {
+        // The output does not exist yet: it cannot be an existing input.
+        return Ok(());
+    };
+    for input in inputs {
+        if std::fs::canonicalize(input).is_ok_and(|i| i == out) {
+            return Err(cloth_vis::Error::Request {
+                path: output.to_owned(),
+                message: format!(
+                    "this output is the input {}; write somewhere else",
+                    input.display()
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Print a command's one summary line on stdout.
 pub fn print_line(line: &str) -> anyhow::Result<()> {
     writeln!(std::io::stdout().lock(), "{line}")?;

@@ -316,6 +316,9 @@ pub fn run_visibility(
     gpu: Option<&GpuContext>,
 ) -> Result<VisibilitySummary, Error> {
     let input = &request.input;
+    for output in request.out.iter().chain(&request.render) {
+        super::refuse_overwriting_input(output, &[input])?;
+    }
     let (out_kind, image_kind) = check_request(request, gpu)?;
     let scene = one_object_scene(request)?;
     let sphere = lightsphere::Lightsphere::new(request.level)?;

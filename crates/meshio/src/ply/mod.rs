@@ -86,7 +86,12 @@ fn read_body<S: Source>(
                 raw.uvs = v.uvs;
             }
             "face" => {
-                raw.triangles.reserve(element.count as usize);
+                // Only a row with properties occupies bytes, so only then does check_sizes bound
+                // the count by the file; a property-less face element is refused below instead
+                // of reserving 2^40 triangles (hard case C1).
+                if !element.properties.is_empty() {
+                    raw.triangles.reserve(element.count as usize);
+                }
                 report.file_face_count += element.count as usize;
                 let triangles = &mut raw.triangles;
                 let polygons = &mut report.polygons_triangulated;

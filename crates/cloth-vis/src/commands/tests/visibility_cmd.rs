@@ -112,3 +112,29 @@ fn bad_requests_are_refused_before_any_work() {
     let err = run_visibility(&depth, None).unwrap_err().to_string();
     assert!(err.contains("--backend cpu"), "{err}");
 }
+
+#[test]
+fn an_output_that_is_the_input_is_refused_however_it_is_spelled() {
+    // Issue #12: `visibility bunny.ply --out bunny.ply` silently overwrote the mesh.
+    let dir = tempfile::tempdir().unwrap();
+    let input = grid_obj(dir.path());
+    let before = std::fs::read(&input).unwrap();
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    let dotted = dir
+        .path()
+        .join("sub")
+        .join("..")
+        .join(input.file_name().unwrap());
+    for out in [input.clone(), dotted] {
+        let mut request = request(input.clone(), None);
+        request.render = Some(out.with_extension("png"));
+        request.out = Some(out.clone());
+        let err = run_visibility(&request, None).unwrap_err().to_string();
+        assert!(err.contains("is the input"), "{err}");
+    }
+    assert_eq!(
+        std::fs::read(&input).unwrap(),
+        before,
+        "the input is untouched"
+    );
+}
