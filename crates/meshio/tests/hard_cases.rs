@@ -263,10 +263,8 @@ fn property_less_face_element_with_a_huge_count_is_an_error_not_an_abort() {
     // Issue #12, C1: `element face 2^40` with no property lines passed the size check (a row
     // of no properties occupies no bytes) and then reserved 2^40 triangles.
     let dir = tempfile::tempdir().unwrap();
-    let text = format!(
-        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
-         property float z\nelement face 1099511627776\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
-    );
+    let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                property float z\nelement face 1099511627776\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
     let err = load(&write(dir.path(), "c1.ply", text)).unwrap_err();
     let message = err.to_string();
     assert!(message.contains("c1.ply"), "{message}");
