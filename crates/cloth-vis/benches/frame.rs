@@ -2,7 +2,8 @@
 //! matrix on the cpu backend (level 3, 258 directions, cloth + ball + ground) and the frame
 //! itself (768², MSAA where offered); and a 12-panel strip with the renderer built once
 //! against one built per panel, as the facade did before (a shader compile and two pipelines
-//! per panel). On a software adapter (lavapipe) the render times prove nothing about a GPU;
+//! per panel); and the display image tone-mapped on the CPU after an HDR read-back against
+//! the GPU tone-map pass. On a software adapter (lavapipe) the render times prove nothing about a GPU;
 //! the strip ratio still shows what per-panel compilation cost.
 //!
 //! `cargo bench -p cloth-vis --bench frame`
@@ -115,6 +116,38 @@ fn bench(c: &mut Criterion) {
                     &camera,
                     Background::Environment,
                     &[],
+                )
+                .unwrap()
+        })
+    });
+    // The display image two ways: the HDR frame read back (16 B/pixel) and tone-mapped on the
+    // CPU, or tone-mapped by the frame's last GPU pass and read back as 8-bit (4 B/pixel) —
+    // what a viewer's per-frame cost depends on.
+    let display = render::tone::Display::default();
+    group.bench_function("display_768_cpu_tone_map_after_hdr_read_back", |b| {
+        b.iter(|| {
+            let hdr = renderer
+                .render(
+                    &gpu.device,
+                    &gpu.queue,
+                    &camera,
+                    Background::Environment,
+                    &[],
+                )
+                .unwrap();
+            render::output::to_rgba8(&hdr, &display, Background::Environment)
+        })
+    });
+    group.bench_function("display_768_gpu_tone_map_pass", |b| {
+        b.iter(|| {
+            renderer
+                .render_display(
+                    &gpu.device,
+                    &gpu.queue,
+                    &camera,
+                    Background::Environment,
+                    &[],
+                    &display,
                 )
                 .unwrap()
         })

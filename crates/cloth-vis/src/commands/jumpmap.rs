@@ -122,6 +122,10 @@ fn anim_error(path: &Path, e: anim_pca::AnimPcaError) -> Error {
     invalid(path, e.to_string())
 }
 
+/// Most bytes of generated positions (F × V × 12) one `anim jumpmap` run holds: 4 GB, e.g.
+/// 100,000 frames of a 3,000-vertex cloth.
+pub const MAX_GENERATED_BYTES: u64 = 4_000_000_000;
+
 /// The kind of output `out` names.
 enum OutKind {
     Npy,
@@ -193,6 +197,24 @@ pub fn run_jumpmap(
         }
     };
     let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
+    // The generated run is held in memory before it is written: bound it by a named limit
+    // rather than growing until the kernel kills the process (issue #12).
+    let run_bytes = (request.frames as u128) * (clip.vertex_count() as u128) * 12;
+    if run_bytes > MAX_GENERATED_BYTES as u128 {
+        return Err(invalid(
+            out,
+            format!(
+                "--frames {}: {} frames of {} vertices take {:.1} GB, above the {} GB this \
+                 command holds in memory; generate fewer frames per run (the jump map is \
+                 endless: run again with another --seed for more)",
+                request.frames,
+                request.frames,
+                clip.vertex_count(),
+                run_bytes as f64 / 1e9,
+                MAX_GENERATED_BYTES / 1_000_000_000
+            ),
+        ));
+    }
     if strip_gpu.is_some() && clip.triangles.is_empty() {
         return Err(invalid(
             &request.input,

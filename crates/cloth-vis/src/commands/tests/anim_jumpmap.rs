@@ -177,6 +177,13 @@ fn bad_requests_are_refused_before_writing() {
     let e = run_jumpmap(&r, None).unwrap_err();
     assert!(e.to_string().contains("missing"), "{e}");
     assert!(!out.exists());
+    // Issue #12: `--frames 1000000000` grew until the kernel killed the process; it is now
+    // refused after loading the clip (V known), before the analysis, naming the flag.
+    let mut r = request(dir.path().join("clip"), out.clone());
+    r.frames = 1_000_000_000;
+    let e = run_jumpmap(&r, None).unwrap_err().to_string();
+    assert!(e.contains("--frames 1000000000") && e.contains("GB"), "{e}");
+    assert!(!out.exists());
 }
 
 /// A GPU context, or `None` after the project's skip policy (fails under CI). Lavapipe wants
