@@ -180,7 +180,7 @@ fn display() -> render::tone::Display {
     }
 }
 
-/// One image as 8-bit RGBA (see [`display`]; the background stays opaque).
+/// One image as 8-bit RGBA: clamped, sRGB-encoded (the seed's BTF display), opaque.
 pub fn single(image: &HdrImage) -> image::RgbaImage {
     let rgba = render::output::to_rgba8(image, &display(), Background::Color([0.0; 3]));
     image::RgbaImage::from_raw(image.width(), image.height(), rgba)
