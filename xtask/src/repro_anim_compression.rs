@@ -387,17 +387,13 @@ fn cluster_picture(
     let path = out.join(&name);
     // The clusters on the decoded clip, as `cloth-vis anim stats --clusters-png` draws them.
     let frames = anim_pca::compress::Decoder::new(&packed).decode_all();
-    let albedo = figures::strip::label_albedo(packed.labels(), packed.clusters());
-    let image = figures::strip::render_strip(
+    let image = figures::strip::render_label_strip(
         &gpu.device,
         &gpu.queue,
         &frames,
         packed.triangles(),
-        &figures::strip::StripOptions {
-            count: figures::strip::DEFAULT_STRIP_FRAMES.min(frames.len()),
-            panel_size: figures::strip::DEFAULT_PANEL_SIZE,
-            albedo: Some(&albedo),
-        },
+        packed.labels(),
+        packed.clusters(),
         &path,
     )?;
     figures::strip::write_png(&path, &image)?;

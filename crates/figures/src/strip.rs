@@ -95,6 +95,36 @@ pub fn label_albedo(labels: &[u32], count: usize) -> Vec<Vec3> {
         .collect()
 }
 
+/// A strip of [`DEFAULT_STRIP_FRAMES`] panels (fewer for a shorter clip) of
+/// [`DEFAULT_PANEL_SIZE`], each vertex coloured by its label in `0..count` ([`label_albedo`]):
+/// the clusters of a compressed clip on its decoded frames (thesis Figs. 3.12/3.13).
+///
+/// # Errors
+/// As [`render_strip`].
+pub fn render_label_strip(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    frames: &[Vec<Vec3>],
+    triangles: &[[u32; 3]],
+    labels: &[u32],
+    count: usize,
+    what: &Path,
+) -> Result<image::RgbaImage, Error> {
+    let albedo = label_albedo(labels, count);
+    render_strip(
+        device,
+        queue,
+        frames,
+        triangles,
+        &StripOptions {
+            count: DEFAULT_STRIP_FRAMES.min(frames.len()).max(1),
+            panel_size: DEFAULT_PANEL_SIZE,
+            albedo: Some(&albedo),
+        },
+        what,
+    )
+}
+
 /// What a strip shows: how many panels, their size, and the vertex colours.
 #[derive(Clone, Copy, Debug)]
 pub struct StripOptions<'a> {

@@ -16,6 +16,7 @@ use std::time::Instant;
 use btf::{BtfDir, BtfPca, BtfPcaParams, ErrorStats, Sampling};
 use glam::Vec3;
 
+use super::invalid as request;
 use cloth_vis::Error;
 use cloth_vis::run::progress_bar as bar;
 
@@ -148,13 +149,6 @@ impl StatsSummary {
             self.error.psnr_db,
             self.error.max_abs_srgb8
         )
-    }
-}
-
-fn request(path: &Path, message: String) -> Error {
-    Error::Request {
-        path: path.to_owned(),
-        message,
     }
 }
 

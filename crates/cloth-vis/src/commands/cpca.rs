@@ -23,6 +23,7 @@ use anim_pca::compress::{
 };
 use glam::Vec3;
 
+use super::{anim_error, invalid};
 use cloth_vis::Error;
 
 /// What `cloth-vis anim compress` was asked to do.
@@ -208,17 +209,6 @@ fn worst_frame(d: &Distortion) -> (usize, f64) {
         (0, 0.0),
         |best, (f, x)| if x > best.1 { (f, x) } else { best },
     )
-}
-
-fn invalid(path: &Path, message: String) -> Error {
-    Error::Request {
-        path: path.to_owned(),
-        message,
-    }
-}
-
-fn anim_error(path: &Path, e: anim_pca::AnimPcaError) -> Error {
-    invalid(path, e.to_string())
 }
 
 /// The kind of output a decompressed animation goes to.
@@ -522,17 +512,13 @@ pub fn cluster_strip(
     what: &Path,
 ) -> Result<image::RgbaImage, Error> {
     let frames = Decoder::new(data).decode_all();
-    let albedo = figures::strip::label_albedo(data.labels(), data.clusters());
-    Ok(figures::strip::render_strip(
+    Ok(figures::strip::render_label_strip(
         &gpu.device,
         &gpu.queue,
         &frames,
         data.triangles(),
-        &figures::strip::StripOptions {
-            count: figures::strip::DEFAULT_STRIP_FRAMES.min(frames.len()),
-            panel_size: figures::strip::DEFAULT_PANEL_SIZE,
-            albedo: Some(&albedo),
-        },
+        data.labels(),
+        data.clusters(),
         what,
     )?)
 }

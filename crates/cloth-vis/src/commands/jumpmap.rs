@@ -11,6 +11,7 @@ use anim_pca::{Blend, Clip, JumpMap, JumpMapParams, LoopTable, PlaybackParams, P
 use glam::Vec3;
 use gpu_context::GpuContext;
 
+use super::{anim_error, invalid};
 use cloth_vis::Error;
 use figures::strip::{check_strip, render_strip, write_png};
 
@@ -109,17 +110,6 @@ impl JumpMapSummary {
             s.max_jump_distance
         )
     }
-}
-
-fn invalid(path: &Path, message: String) -> Error {
-    Error::Request {
-        path: path.to_owned(),
-        message,
-    }
-}
-
-fn anim_error(path: &Path, e: anim_pca::AnimPcaError) -> Error {
-    invalid(path, e.to_string())
 }
 
 /// Most bytes of generated positions (F × V × 12) one `anim jumpmap` run holds: 4 GB, e.g.

@@ -24,6 +24,19 @@ pub fn optional_gpu() -> Option<GpuContext> {
     GpuContext::new(&GpuOptions::default()).ok()
 }
 
+/// A request refused before any work: [`cloth_vis::Error::Request`] naming `path`.
+pub fn invalid(path: &std::path::Path, message: String) -> cloth_vis::Error {
+    cloth_vis::Error::Request {
+        path: path.to_owned(),
+        message,
+    }
+}
+
+/// An `anim-pca` error about the file `path` (its message names the parameter and value).
+pub fn anim_error(path: &std::path::Path, e: anim_pca::AnimPcaError) -> cloth_vis::Error {
+    invalid(path, e.to_string())
+}
+
 /// Refuses an output path that names an input (the same file, however spelled: through
 /// `..`, a symlink or a hard link), before any work — `visibility bunny.ply --out bunny.ply`
 /// would otherwise overwrite the mesh it reads.

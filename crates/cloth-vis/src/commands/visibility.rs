@@ -43,6 +43,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use super::invalid;
 use cloth_vis::Error;
 use cloth_vis::lighting::{environment_rotation, shadowed_radiance};
 use cloth_vis::run::render_still_image;
@@ -151,13 +152,6 @@ impl VisibilitySummary {
             self.millis,
             self.backend.name()
         )
-    }
-}
-
-fn invalid(path: &Path, message: String) -> Error {
-    Error::Request {
-        path: path.to_owned(),
-        message,
     }
 }
 
