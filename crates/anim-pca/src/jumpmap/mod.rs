@@ -39,7 +39,9 @@ pub mod probability;
 
 mod analysis;
 mod cells;
+mod params;
 mod reconstruct;
+mod validate;
 
 pub use analysis::{CLOSING_MATCH, Clip, JumpMap, JumpMapParams, RootMotion};
 pub use loops::{Loop, LoopTable};
