@@ -109,10 +109,10 @@ impl JumpMap {
     /// normals and [`JumpMap::analyze_cells`] for attributes and several clips.
     ///
     /// # Errors
-    /// [`AnimPcaError::EmptyClip`] (no frames or no vertices), [`AnimPcaError::TooFewFrames`]
-    /// (one frame), [`AnimPcaError::VertexCountMismatch`], [`AnimPcaError::NonFinite`],
-    /// [`AnimPcaError::InvalidParameter`] for c = 0, c* = 0, σ ≤ 0 or NaN, q ∉ [0, 1], and
-    /// [`AnimPcaError::Pca`] if the decomposition fails.
+    /// [`crate::AnimPcaError::EmptyClip`] (no frames or no vertices), [`crate::AnimPcaError::TooFewFrames`]
+    /// (one frame), [`crate::AnimPcaError::VertexCountMismatch`], [`crate::AnimPcaError::NonFinite`],
+    /// [`crate::AnimPcaError::InvalidParameter`] for c = 0, c* = 0, σ ≤ 0 or NaN, q ∉ [0, 1], and
+    /// [`crate::AnimPcaError::Pca`] if the decomposition fails.
     ///
     /// # Examples
     /// ```
@@ -139,8 +139,8 @@ impl JumpMap {
     /// neither swamps the PCA. Velocities use positions only.
     ///
     /// # Errors
-    /// As [`JumpMap::analyze`]; also [`AnimPcaError::TooFewFrames`] /
-    /// [`AnimPcaError::VertexCountMismatch`] when `normals` does not match `positions`.
+    /// As [`JumpMap::analyze`]; also [`crate::AnimPcaError::TooFewFrames`] /
+    /// [`crate::AnimPcaError::VertexCountMismatch`] when `normals` does not match `positions`.
     pub fn analyze_with_normals(
         positions: &[Vec<Vec3>],
         normals: &[Vec<Vec3>],
@@ -165,7 +165,7 @@ impl JumpMap {
     /// to but do not enter D: the jump structure is the motion's (eqs. 3.2, 3.5).
     ///
     /// # Errors
-    /// As [`JumpMap::analyze`] for every clip; [`AnimPcaError::InvalidCell`] when no clip is
+    /// As [`JumpMap::analyze`] for every clip; [`crate::AnimPcaError::InvalidCell`] when no clip is
     /// given, or the clips disagree on vertex count, on having normals or attributes, or on
     /// the attribute length.
     ///
