@@ -1,6 +1,8 @@
 //! The parameters of the jump-map analysis (thesis §3.2.2, eqs. 3.3–3.8) and their checks.
 
 use super::analysis::WHAT;
+#[cfg(doc)]
+use super::analysis::{Clip, JumpMap};
 use crate::error::{Result, invalid};
 
 /// Parameters of the analysis (thesis §3.2.2). Defaults are the thesis's figures: c = 10,
