@@ -107,25 +107,48 @@ impl GpuContext {
             .or_else(|| env_nonempty(ADAPTER_ENV).map(|n| (n, ADAPTER_ENV)))
             .or_else(|| env_nonempty("WGPU_ADAPTER_NAME").map(|n| (n, "WGPU_ADAPTER_NAME")));
         let infos: Vec<wgpu::AdapterInfo> = adapters.iter().map(|a| a.get_info()).collect();
+        let missing: Vec<Vec<&'static str>> = adapters.iter().map(missing_capabilities).collect();
+        let unsupported = || GpuError::Unsupported {
+            adapters: infos
+                .iter()
+                .zip(&missing)
+                .filter(|(_, m)| !m.is_empty())
+                .map(|(i, m)| format!("{} ({:?}) lacks {}", i.name, i.backend, m.join(", ")))
+                .collect::<Vec<_>>()
+                .join("; "),
+        };
         let index = match wanted {
             Some((name, env)) => {
                 let lower = name.to_lowercase();
-                infos
+                let index = infos
                     .iter()
                     .position(|i| i.name.to_lowercase().contains(&lower))
                     .ok_or_else(|| GpuError::AdapterNotFound {
                         wanted: name.clone(),
                         env,
                         available: list_names(&infos),
-                    })?
+                    })?;
+                if !missing[index].is_empty() {
+                    return Err(unsupported());
+                }
+                index
             }
             None => {
-                let kinds: Vec<_> = infos.iter().map(|i| (i.device_type, i.backend)).collect();
-                best_adapter(&kinds, options.allow_software).ok_or_else(|| GpuError::NoAdapter {
-                    backends: format!("{backends:?}"),
-                    seen: list_names(&infos),
-                    env: BACKEND_ENV,
-                })?
+                let kinds: Vec<_> = infos
+                    .iter()
+                    .zip(&missing)
+                    .map(|(i, m)| (i.device_type, i.backend, m.is_empty()))
+                    .collect();
+                match best_adapter(&kinds, options.allow_software) {
+                    Some(index) => index,
+                    None if missing.iter().any(|m| !m.is_empty()) => return Err(unsupported()),
+                    None => {
+                        return Err(GpuError::NoAdapter {
+                            backends: format!("{backends:?}"),
+                            seen: list_names(&infos),
+                        });
+                    }
+                }
             }
         };
         let adapter = adapters.into_iter().nth(index).ok_or_else(|| {
@@ -157,6 +180,9 @@ impl GpuContext {
             adapter: summary.name.clone(),
             source,
         })?;
+        // wgpu's default for a validation error is a panic; record it instead, so that the next
+        // read-back or wait returns it as `GpuError::Validation` (see `take_device_error`).
+        device.on_uncaptured_error(std::sync::Arc::new(record_device_error));
         log::info!("GPU adapter: {summary}");
         Ok(Self {
             instance,
@@ -179,8 +205,8 @@ impl GpuContext {
     pub fn wait_idle(&self) -> Result<(), GpuError> {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError::Readback(e.to_string()))
+            .map_err(|e| GpuError::Readback(e.to_string()))?;
+        check_device_errors()
     }
 }
 
@@ -207,13 +233,72 @@ fn list_names(infos: &[wgpu::AdapterInfo]) -> String {
         .join(", ")
 }
 
+/// What an adapter lacks of what the workspace's GPU paths need, by name; empty when it can
+/// run them all. The paths assume WebGPU: compute shaders, depth textures read with
+/// `textureLoad` and copied to buffers (the depth visibility backend), read-only depth-stencil
+/// (the shared frame) and 32-bit index draws; the shared frame renders into `Rgba32Float`.
+/// Mesa's GL driver, for one, misses several of these and would fail inside wgpu.
+fn missing_capabilities(adapter: &wgpu::Adapter) -> Vec<&'static str> {
+    let mut missing: Vec<&'static str> = Vec::new();
+    let downlevel = adapter.get_downlevel_capabilities();
+    let lacking = wgpu::DownlevelFlags::compliant() - downlevel.flags;
+    missing.extend(lacking.iter_names().map(|(name, _)| name));
+    let float_target = adapter.get_texture_format_features(crate::COLOR_FORMAT);
+    if !float_target
+        .allowed_usages
+        .contains(wgpu::TextureUsages::RENDER_ATTACHMENT)
+    {
+        missing.push("Rgba32Float render targets");
+    }
+    missing
+}
+
+/// Validation errors recorded by the devices this crate created, oldest first.
+static DEVICE_ERRORS: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+fn record_device_error(error: wgpu::Error) {
+    log::error!("GPU validation error: {error}");
+    let mut errors = DEVICE_ERRORS.lock().unwrap_or_else(|e| e.into_inner());
+    // Bounded: one broken pipeline makes every later draw fail the same way.
+    if errors.len() < 16 {
+        errors.push(error.to_string());
+    }
+}
+
+/// Take the validation errors that the devices created by [`GpuContext::new`] reported since
+/// the last call (wgpu reports them asynchronously; without a handler it panics). `None` when
+/// there were none. Read-backs and [`GpuContext::wait_idle`] call this and return
+/// [`GpuError::Validation`]; code with its own read-back should do the same.
+pub fn take_device_error() -> Option<String> {
+    let mut errors = DEVICE_ERRORS.lock().unwrap_or_else(|e| e.into_inner());
+    if errors.is_empty() {
+        return None;
+    }
+    let joined = errors
+        .iter()
+        .map(|e| e.trim().replace('\n', " "))
+        .collect::<Vec<_>>()
+        .join("; ");
+    errors.clear();
+    Some(joined)
+}
+
+/// `Err(GpuError::Validation)` when a device reported an error since the last check.
+pub(crate) fn check_device_errors() -> Result<(), GpuError> {
+    take_device_error().map_or(Ok(()), |e| Err(GpuError::Validation(e)))
+}
+
 /// Rank adapters by (device type, backend): hardware before software, Vulkan/Metal/DX12
-/// before GL. Returns the index of the best one.
+/// before GL; adapters lacking a needed capability (the `bool` is false) are never chosen.
+/// Returns the index of the best one.
 fn best_adapter(
-    kinds: &[(wgpu::DeviceType, wgpu::Backend)],
+    kinds: &[(wgpu::DeviceType, wgpu::Backend, bool)],
     allow_software: bool,
 ) -> Option<usize> {
-    let rank = |(device_type, backend): (wgpu::DeviceType, wgpu::Backend)| -> Option<u32> {
+    let rank = |(device_type, backend, capable): (wgpu::DeviceType, wgpu::Backend, bool)| {
+        if !capable {
+            return None;
+        }
         let device = match device_type {
             wgpu::DeviceType::DiscreteGpu => 0,
             wgpu::DeviceType::IntegratedGpu => 1,
@@ -240,13 +325,30 @@ mod tests {
     #[test]
     fn hardware_is_preferred_over_software_and_vulkan_over_gl() {
         let kinds = [
-            (DeviceType::Cpu, Backend::Vulkan),
-            (DeviceType::IntegratedGpu, Backend::Gl),
-            (DeviceType::IntegratedGpu, Backend::Vulkan),
+            (DeviceType::Cpu, Backend::Vulkan, true),
+            (DeviceType::IntegratedGpu, Backend::Gl, true),
+            (DeviceType::IntegratedGpu, Backend::Vulkan, true),
         ];
         assert_eq!(best_adapter(&kinds, true), Some(2));
         assert_eq!(best_adapter(&kinds[..1], true), Some(0));
         assert_eq!(best_adapter(&kinds[..1], false), None);
         assert_eq!(best_adapter(&[], true), None);
+    }
+
+    #[test]
+    fn an_adapter_lacking_a_capability_is_never_chosen() {
+        // Mesa's GL driver beside lavapipe: the capable software Vulkan adapter wins even
+        // though GL ranks the same device type; alone, the incapable one gives None.
+        let kinds = [
+            (DeviceType::Cpu, Backend::Gl, false),
+            (DeviceType::Cpu, Backend::Vulkan, true),
+        ];
+        assert_eq!(best_adapter(&kinds, true), Some(1));
+        assert_eq!(best_adapter(&kinds[..1], true), None);
+        let discrete_but_incapable = [
+            (DeviceType::DiscreteGpu, Backend::Vulkan, false),
+            (DeviceType::Cpu, Backend::Vulkan, true),
+        ];
+        assert_eq!(best_adapter(&discrete_but_incapable, true), Some(1));
     }
 }

@@ -10,16 +10,29 @@ pub enum GpuError {
         "no GPU adapter found (backends tried: {backends}; adapters seen: {seen}). \
          On a machine without a GPU install Mesa's software Vulkan driver \
          (`apt-get install mesa-vulkan-drivers`) and, if unset, export XDG_RUNTIME_DIR; \
-         or widen the backends with {env}=vulkan,gl"
+         commands with a `--backend cpu` option run without a GPU"
     )]
     NoAdapter {
         /// The backends that were searched.
         backends: String,
         /// Adapters that exist but were excluded (name and backend), or `none`.
         seen: String,
-        /// The environment variable that restricts backends.
-        env: &'static str,
     },
+    /// Adapters exist, but none offers what the GPU paths need (Mesa's GL driver, for one:
+    /// no `textureLoad` from depth textures, no `Rgba32Float` render targets).
+    #[error(
+        "no usable GPU adapter: {adapters}. Install a Vulkan driver (on a machine without a \
+         GPU, Mesa's software one: `apt-get install mesa-vulkan-drivers`); commands with a \
+         `--backend cpu` option run without a GPU"
+    )]
+    Unsupported {
+        /// Each adapter with the capabilities it lacks.
+        adapters: String,
+    },
+    /// The device reported a validation error (recorded by the handler that
+    /// [`GpuContext::new`](crate::GpuContext::new) installs instead of wgpu's panic).
+    #[error("the GPU rejected the work: {0}")]
+    Validation(String),
     /// `CLOTH_VIS_ADAPTER` named an adapter that does not exist.
     #[error("no adapter name contains {wanted:?} (set by {env}); available: {available}")]
     AdapterNotFound {

@@ -17,8 +17,12 @@
 //! 3. a software adapter, e.g. Mesa's lavapipe (`apt-get install mesa-vulkan-drivers`), which is
 //!    what CI and machines without a GPU use.
 //!
-//! With no adapter at all, [`GpuContext::new`] returns [`GpuError::NoAdapter`], whose message
-//! says what to install.
+//! Only adapters that offer what the GPU paths need are chosen (WebGPU's downlevel flags and
+//! `Rgba32Float` render targets; Mesa's GL driver lacks both). With no adapter at all,
+//! [`GpuContext::new`] returns [`GpuError::NoAdapter`], and with adapters that all lack
+//! something [`GpuError::Unsupported`] naming what; both messages say what to install. The
+//! device records validation errors instead of panicking (wgpu's default), and the next
+//! read-back returns them as [`GpuError::Validation`].
 //!
 //! No seed section: this is infrastructure (DESIGN.md, "GPU").
 //!
@@ -39,7 +43,9 @@ mod offscreen;
 pub mod pipeline;
 pub mod testing;
 
-pub use adapter::{ADAPTER_ENV, AdapterSummary, BACKEND_ENV, GpuContext, GpuOptions};
+pub use adapter::{
+    ADAPTER_ENV, AdapterSummary, BACKEND_ENV, GpuContext, GpuOptions, take_device_error,
+};
 pub use error::GpuError;
 pub use image_out::{HdrImage, write_rgba8_png};
 pub use offscreen::{

@@ -206,7 +206,8 @@ pub fn read_texture(
 /// into a staging buffer, one map, one blocking wait.
 ///
 /// # Errors
-/// [`GpuError::Readback`] when mapping fails or the device is lost.
+/// [`GpuError::Readback`] when mapping fails or the device is lost;
+/// [`GpuError::Validation`] when the device reported a validation error since the last check.
 pub fn read_buffer(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
@@ -251,5 +252,7 @@ fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>, Gpu
     let bytes = mapped.to_vec();
     drop(mapped);
     buffer.unmap();
+    // Work that failed validation leaves zeros behind: report the error, not the zeros.
+    crate::adapter::check_device_errors()?;
     Ok(bytes)
 }

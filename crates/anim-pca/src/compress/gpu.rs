@@ -504,6 +504,9 @@ impl GpuDecoder {
         let out = xyzw.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
         drop(mapped);
         staging.unmap();
+        if let Some(error) = gpu_context::take_device_error() {
+            return Err(readback(&error));
+        }
         Ok(out)
     }
 }

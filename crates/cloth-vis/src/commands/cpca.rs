@@ -690,10 +690,10 @@ pub struct StatsArgs {
 impl StatsArgs {
     /// Compare, write the pictures asked for; print the summary line.
     pub fn run(self) -> anyhow::Result<()> {
-        let gpu = self
-            .clusters_png
-            .as_ref()
-            .and_then(|_| super::optional_gpu());
+        let gpu = match &self.clusters_png {
+            Some(png) => Some(super::required_gpu(png, "--clusters-png")?),
+            None => None,
+        };
         let request = StatsRequest {
             original: self.original,
             cpca: self.cpca,

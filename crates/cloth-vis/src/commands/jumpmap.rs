@@ -625,8 +625,10 @@ impl JumpmapArgs {
     /// Generate and write; print the summary line.
     pub fn run(self) -> anyhow::Result<()> {
         let request = self.request();
-        // --strip without an adapter is refused by run_jumpmap, naming the flag.
-        let gpu = request.strip.as_ref().and_then(|_| super::optional_gpu());
+        let gpu = match &request.strip {
+            Some(strip) => Some(super::required_gpu(&strip.path, "--strip")?),
+            None => None,
+        };
         let summary = run_jumpmap(&request, gpu.as_ref())?;
         super::print_line(&summary.line())
     }

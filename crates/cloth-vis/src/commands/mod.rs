@@ -18,10 +18,17 @@ use std::io::Write as _;
 
 use gpu_context::{GpuContext, GpuOptions};
 
-/// A GPU context when an adapter exists; commands that need one refuse the request with a
-/// message naming the flag (and the software driver to install) when it is `None`.
+/// A GPU context when a usable adapter exists, for paths that fall back to the CPU without one.
 pub fn optional_gpu() -> Option<GpuContext> {
     GpuContext::new(&GpuOptions::default()).ok()
+}
+
+/// A GPU context for the output `path` that `flag` asks for, or the request refused naming the
+/// flag, the file and gpu-context's reason (no adapter, or adapters that lack what is needed,
+/// with what to install).
+pub fn required_gpu(path: &std::path::Path, flag: &str) -> Result<GpuContext, cloth_vis::Error> {
+    GpuContext::new(&GpuOptions::default())
+        .map_err(|e| invalid(path, format!("{flag} renders on the GPU: {e}")))
 }
 
 /// A request refused before any work: [`cloth_vis::Error::Request`] naming `path`.

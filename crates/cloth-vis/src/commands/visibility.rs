@@ -618,8 +618,10 @@ impl VisibilityArgs {
             Some(Backend::Depth | Backend::Query) => {
                 Some(GpuContext::new(&gpu_context::GpuOptions::default())?)
             }
-            // --render without an adapter is refused by run_visibility, naming the flag.
-            _ => super::optional_gpu(),
+            _ => match &self.render {
+                Some(path) => Some(super::required_gpu(path, "--render")?),
+                None => super::optional_gpu(),
+            },
         };
         let request = VisibilityRequest {
             input: self.input,

@@ -28,6 +28,15 @@ pub fn cli(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// Runs the `cloth-vis` binary with `args` and the environment variables `envs` set.
+pub fn cli_env(args: &[&str], envs: &[(&str, &str)]) -> std::process::Output {
+    std::process::Command::new(binary())
+        .args(args)
+        .envs(envs.iter().copied())
+        .output()
+        .unwrap()
+}
+
 /// A path as a command-line argument.
 pub fn text(p: &Path) -> &str {
     p.to_str().unwrap()

@@ -1,6 +1,7 @@
 //! `cloth-vis visibility` end to end on the cpu backend (no GPU needed): array shapes, NaN for
 //! vertices used by no face, a PLY that our own loader reads back, and refusals before work.
 
+use super::common::{cli_env, text};
 use crate::commands::visibility::{VisibilityRequest, run_visibility};
 use cloth_vis::Error;
 
@@ -137,4 +138,57 @@ fn an_output_that_is_the_input_is_refused_however_it_is_spelled() {
         before,
         "the input is untouched"
     );
+}
+
+#[test]
+fn a_machine_without_vulkan_gets_an_error_not_a_panic() {
+    // Issue #12, C7: with the Vulkan loader pointed at nothing, wgpu fell back to Mesa's GL
+    // driver, which cannot run our shaders, and every GPU command panicked inside wgpu;
+    // `--backend cpu --render` wrote its .npy first. Now the adapter chooser refuses adapters
+    // that lack what the paths need (or finds none, where GL is absent too), exit code 1.
+    let dir = tempfile::tempdir().unwrap();
+    let input = grid_obj(dir.path());
+    let npy = dir.path().join("a.npy");
+    let png = dir.path().join("a.png");
+    let no_vulkan = [
+        ("VK_ICD_FILENAMES", "/nonexistent.json"),
+        ("VK_DRIVER_FILES", "/nonexistent.json"),
+        ("CLOTH_VIS_BACKEND", ""),
+        ("WGPU_BACKEND", ""),
+    ];
+    let runs: [&[&str]; 2] = [
+        &[
+            "visibility",
+            text(&input),
+            "--backend",
+            "depth",
+            "--level",
+            "1",
+            "--out",
+            text(&npy),
+        ],
+        &[
+            "visibility",
+            text(&input),
+            "--backend",
+            "cpu",
+            "--level",
+            "1",
+            "--out",
+            text(&npy),
+            "--render",
+            text(&png),
+        ],
+    ];
+    for args in runs {
+        let out = cli_env(args, &no_vulkan);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(
+            stderr.contains("apt-get install mesa-vulkan-drivers"),
+            "the message says what to install: {stderr}"
+        );
+        assert!(!npy.exists() && !png.exists(), "nothing is written");
+    }
 }
