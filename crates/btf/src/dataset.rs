@@ -26,6 +26,51 @@ use crate::error::{BtfError, Result};
 use crate::io::{decode_into, kind_of, read_dimensions};
 use crate::sampling::{DIRECTIONS, Sampling};
 
+/// The largest normtexture side accepted from an image header (resource policy, ARCHITECTURE.md).
+/// A view slot holds 81 · 3 · w · h f32, 1.0 GB at 1024²; measured BTFs are 256² or smaller
+/// (the thesis's UBO2003 samples), and a larger one should be cropped into tiles first.
+pub const MAX_NORMTEXTURE_SIDE: usize = 1024;
+
+/// Deflate, the compression of PNG, cannot shrink data by more than 1032:1; a header that
+/// claims more raw bytes than that times the file size (plus the header's own bytes) describes
+/// pixels the file cannot hold.
+const DEFLATE_MAX_RATIO: u64 = 1032;
+
+/// Refuses an image size beyond [`MAX_NORMTEXTURE_SIDE`], or a PNG whose claimed pixels its
+/// bytes cannot hold, before anything of that size is allocated.
+fn check_image_size(path: &Path, width: usize, height: usize) -> Result<()> {
+    let too_large = |reason: String| BtfError::ImageTooLarge {
+        path: path.to_path_buf(),
+        width,
+        height,
+        reason,
+    };
+    if width > MAX_NORMTEXTURE_SIDE || height > MAX_NORMTEXTURE_SIDE {
+        return Err(too_large(format!(
+            "each side may be at most {MAX_NORMTEXTURE_SIDE} (btf::MAX_NORMTEXTURE_SIDE); crop \
+             a larger BTF into tiles"
+        )));
+    }
+    let is_png = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if is_png {
+        let file_bytes = std::fs::metadata(path)
+            .map_err(|e| BtfError::io(path, "stat", e))?
+            .len();
+        // At least one byte per pixel (8-bit grey), one filter byte per row.
+        let raw = (width as u64 + 1) * height as u64;
+        if raw > DEFLATE_MAX_RATIO * file_bytes + 4096 {
+            return Err(too_large(format!(
+                "the file has {file_bytes} bytes, and deflate cannot compress {raw} bytes of \
+                 pixels into so few; the header is corrupt"
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Number of (view, light) pairs: 81 × 81 = 6,561 images.
 pub(crate) const fn pair_count() -> usize {
     DIRECTIONS * DIRECTIONS
@@ -351,6 +396,7 @@ fn check_sizes(files: &[PathBuf]) -> Result<(usize, usize)> {
     let mut reference: Option<(usize, usize)> = None;
     for (path, size) in files.iter().zip(sizes) {
         let (w, h) = size?;
+        check_image_size(path, w, h)?;
         match reference {
             None => {
                 if w == 0 || h == 0 {

@@ -106,6 +106,20 @@ pub enum BtfError {
         /// The folder.
         dir: PathBuf,
     },
+    /// An image header claims a size the resource policy refuses: larger than
+    /// [`MAX_NORMTEXTURE_SIDE`](crate::MAX_NORMTEXTURE_SIDE), or (PNG) more pixels than its
+    /// compressed bytes can hold.
+    #[error("{path}: the header claims {width} × {height} pixels; {reason}")]
+    ImageTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Width from the header.
+        width: usize,
+        /// Height from the header.
+        height: usize,
+        /// Which limit and why.
+        reason: String,
+    },
     /// Images of one BTF differ in size.
     #[error(
         "{path}: the image is {found_w} × {found_h} but {reference} is {expected_w} × \

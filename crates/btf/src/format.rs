@@ -122,7 +122,7 @@ impl BtfPca {
     /// [`BtfError::Io`] if it cannot be read, [`BtfError::Format`] naming the file and the
     /// first invalid field.
     pub fn read(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path).map_err(|e| BtfError::io(path, "read", e))?;
+        let bytes = input_guard::read_regular(path).map_err(|e| BtfError::io(path, "read", e))?;
         parse(&bytes, path)
     }
 }

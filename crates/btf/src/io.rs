@@ -67,12 +67,23 @@ pub(crate) fn srgb8_table() -> &'static [f32; 256] {
     TABLE.get_or_init(|| std::array::from_fn(|c| srgb_to_linear(c as f32 / 255.0)))
 }
 
+/// An image reader over the regular file `path` (a FIFO named like an image would block).
+fn open_image(path: &Path) -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>> {
+    let file = input_guard::open_regular(path).map_err(|e| BtfError::io(path, "open", e))?;
+    let mut reader = image::ImageReader::new(std::io::BufReader::new(file));
+    // The extension's format, as `ImageReader::open` would set it; the content's signature,
+    // when recognised, takes precedence (`with_guessed_format`).
+    if let Ok(format) = image::ImageFormat::from_path(path) {
+        reader.set_format(format);
+    }
+    Ok(reader)
+}
+
 /// Width and height from the file's header only (no pixel data is decoded).
 pub(crate) fn read_dimensions(path: &Path) -> Result<(usize, usize)> {
     match kind_of_path(path) {
         Kind::Raster => {
-            let reader = image::ImageReader::open(path)
-                .map_err(|e| BtfError::io(path, "open", e))?
+            let reader = open_image(path)?
                 .with_guessed_format()
                 .map_err(|e| BtfError::io(path, "read", e))?;
             let (w, h) = reader
@@ -81,6 +92,8 @@ pub(crate) fn read_dimensions(path: &Path) -> Result<(usize, usize)> {
             Ok((w as usize, h as usize))
         }
         Kind::Exr => {
+            // The exr crate opens by path: refuse a FIFO or a device first.
+            input_guard::open_regular(path).map_err(|e| BtfError::io(path, "open", e))?;
             let meta = exr::meta::MetaData::read_from_file(path, false)
                 .map_err(|e| BtfError::codec(path, "read the header of", e))?;
             let header = meta
@@ -125,10 +138,15 @@ fn size_error(path: &Path, width: usize, height: usize, w: usize, h: usize) -> B
 }
 
 fn decode_raster(path: &Path, width: usize, height: usize, out: &mut [f32]) -> Result<()> {
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| BtfError::io(path, "open", e))?
+    let mut reader = open_image(path)?
         .with_guessed_format()
         .map_err(|e| BtfError::io(path, "read", e))?;
+    // The decoder allocates from the header, which `BtfDir::open` checked: bound it by the
+    // size found then, in case the file changed since.
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(u32::try_from(width).unwrap_or(u32::MAX));
+    limits.max_image_height = Some(u32::try_from(height).unwrap_or(u32::MAX));
+    reader.limits(limits);
     let img = reader
         .decode()
         .map_err(|e| BtfError::codec(path, "decode", e))?;

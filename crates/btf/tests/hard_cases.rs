@@ -1,5 +1,6 @@
 //! Named adversarial cases of light/view interpolation and per-view PCA (DESIGN.md, "Hard
-//! cases stay numerically stable").
+//! cases stay numerically stable"), and of the BTF folder reader (issue #12): image headers
+//! that claim more pixels than their files hold, and a FIFO named like an image.
 
 mod common;
 
@@ -336,4 +337,78 @@ fn texel_reconstruction_equals_direct_f64_evaluation_of_the_stored_pca() {
         // The whole-image path gives the same texel, bit for bit.
         assert_eq!(pca.image_from_gamma(j, &gamma)[y * res + x], got);
     }
+}
+
+/// `png` with the IHDR width and height replaced (CRC recomputed): a valid header that claims
+/// pixels the file does not hold.
+fn png_claiming(png: &[u8], width: u32, height: u32) -> Vec<u8> {
+    let mut out = png.to_vec();
+    // Signature (8), IHDR length (4), "IHDR" (4), width (4), height (4), … CRC after 13 bytes.
+    out[16..20].copy_from_slice(&width.to_be_bytes());
+    out[20..24].copy_from_slice(&height.to_be_bytes());
+    let crc = crc32fast::hash(&out[12..29]);
+    out[29..33].copy_from_slice(&crc.to_be_bytes());
+    out
+}
+
+#[test]
+fn image_headers_that_claim_more_than_the_file_holds() {
+    // Issue #12, C3: every image replaced by a 70-byte PNG whose header claims 8192 × 8192,
+    // and `btf compress` allocated 65 GB from the header sizes. Now the sizes are checked
+    // before anything is allocated: beyond btf::MAX_NORMTEXTURE_SIDE, or (PNG) more pixels
+    // than deflate can pack into the file's bytes.
+    let tiny = common::png_bytes(1, 1);
+    for (w, h, name, why) in [
+        (8192, 8192, "huge", "at most 1024"),
+        (1024, 1024, "packed", "deflate cannot compress"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        common::write_tiny_dir(dir.path(), Sampling::H1, 1, 1);
+        let victim = dir
+            .path()
+            .join(btf::image_file_name(Sampling::H1, 0, 0, "png"));
+        let claiming = png_claiming(&tiny, w, h);
+        assert!(
+            claiming.len() < 100,
+            "{name}: a {}-byte file",
+            claiming.len()
+        );
+        std::fs::write(&victim, &claiming).unwrap();
+        let err = btf::BtfDir::open(dir.path()).unwrap_err();
+        let message = err.to_string();
+        assert!(
+            matches!(err, btf::BtfError::ImageTooLarge { .. }),
+            "{name}: {err:?}"
+        );
+        assert!(
+            message.contains(&format!("{w} × {h}")) && message.contains(why),
+            "{message}"
+        );
+        assert!(
+            message.contains(victim.file_name().unwrap().to_str().unwrap()),
+            "{message}"
+        );
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_named_like_an_image_is_refused_not_waited_on() {
+    let dir = tempfile::tempdir().unwrap();
+    common::write_tiny_dir(dir.path(), Sampling::H1, 1, 1);
+    let victim = dir
+        .path()
+        .join(btf::image_file_name(Sampling::H1, 3, 5, "png"));
+    std::fs::remove_file(&victim).unwrap();
+    let status = std::process::Command::new("mkfifo")
+        .arg(&victim)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let message = btf::BtfDir::open(dir.path()).unwrap_err().to_string();
+    assert!(message.contains("FIFO"), "{message}");
+    assert!(
+        message.contains(victim.file_name().unwrap().to_str().unwrap()),
+        "{message}"
+    );
 }

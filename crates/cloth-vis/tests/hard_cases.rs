@@ -1,5 +1,7 @@
 //! Named adversarial cases for the facade: huge coordinate offsets, mirroring transforms,
-//! frames outside an animation, a sun 10⁴× the sky, real meshes with unreferenced vertices.
+//! frames outside an animation, a sun 10⁴× the sky, real meshes with unreferenced vertices,
+//! scene values that would run for minutes (a 16384-wide sky) refused before any work, and a
+//! scene file that is a FIFO.
 
 mod common;
 
@@ -148,4 +150,43 @@ fn a_corrupt_mesh_file_fails_with_its_name_and_no_output() {
         .map(|d| d.flatten().collect())
         .unwrap_or_default();
     assert!(leftovers.is_empty(), "partial output: {leftovers:?}");
+}
+
+#[test]
+fn a_sky_too_wide_for_any_use_is_refused_by_key_before_any_work() {
+    // Issue #12: `sky_width = 16384` with `prefilter_sigma_deg = 90` passed validation and was
+    // still running after 60 s at 6.2 GB.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let text = "[[object]]\nname = \"cloth\"\nsource = \"synth:cloth\"\n\
+                [environment]\nsource = \"synth:sky\"\nprefilter_sigma_deg = 90\n\
+                [synth]\nsky_width = 16384\n";
+    let scene = Scene::from_toml(text, dir.path(), "wide.toml").unwrap();
+    let message = scene.validate().unwrap_err().to_string();
+    assert!(
+        message.contains("wide.toml")
+            && message.contains("synth.sky_width")
+            && message.contains("16384"),
+        "{message}"
+    );
+    let err = run_scene(&scene, &out, &RunOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("synth.sky_width"), "{err}");
+    assert!(!out.exists(), "the output folder is not created");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_scene_file_that_is_a_fifo_is_refused_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("scene.toml");
+    let status = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let message = Scene::load(&fifo).unwrap_err().to_string();
+    assert!(
+        message.contains("scene.toml") && message.contains("FIFO"),
+        "{message}"
+    );
 }

@@ -51,6 +51,27 @@ pub enum LightsphereError {
         max_texels: usize,
     },
 
+    /// A Radiance header claims more texels than its file's bytes can encode.
+    #[error(
+        "{path}: the header claims {width}x{height} texels, but the file has {bytes} bytes and \
+         run-length encoded scanlines hold at most {per_byte} texels per byte beyond the first \
+         {floor} texels; the header is corrupt or the file truncated"
+    )]
+    HdrHeaderTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Width from the header.
+        width: usize,
+        /// Height from the header.
+        height: usize,
+        /// The file's size.
+        bytes: u64,
+        /// [`crate::HDR_TEXELS_PER_BYTE`].
+        per_byte: u64,
+        /// [`crate::HDR_TEXELS_FLOOR`].
+        floor: u64,
+    },
+
     /// `from_latlong` was given the wrong number of texels.
     #[error(
         "from_latlong: a {width}x{height} map needs {expected} texels but {actual} were given; \

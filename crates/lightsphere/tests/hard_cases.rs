@@ -1,5 +1,6 @@
 //! Named adversarial cases: a sun 10⁴× the mean, 1×1 and 2×1 maps, invalid texels, truncated
-//! and oversized files, look-ups exactly at the poles and seams, rotation by 360°, degenerate
+//! and oversized files (a header claiming more texels than its bytes hold; FIFOs and devices
+//! named like maps), look-ups exactly at the poles and seams, rotation by 360°, degenerate
 //! queries and parameters.
 
 mod common;
@@ -236,6 +237,54 @@ fn oversized_hdr_header_is_rejected_before_allocation() {
         err.to_string().contains("huge.hdr") && err.to_string().contains("1000000"),
         "{err}"
     );
+}
+
+#[test]
+fn a_tiny_hdr_whose_header_claims_gigabytes_is_refused_before_allocation() {
+    // Issue #12: a 52-byte .hdr saying `-Y 8192 +X 16384` (within the size limits) allocated
+    // 1.6 GB before failing. Beyond 2^22 texels the header must be backed by the file's bytes.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("liar.hdr");
+    write_flat_hdr(&path, 16_384, 8_192, &[]);
+    assert!(std::fs::metadata(&path).unwrap().len() < 64);
+    let err = Environment::load(&path).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            LightsphereError::HdrHeaderTooLarge {
+                width: 16_384,
+                height: 8_192,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("liar.hdr"), "{err}");
+    // Up to the floor the header is taken at its word, and the short data is the error.
+    write_flat_hdr(&path, 2048, 2048, &[]);
+    assert!(matches!(
+        Environment::load(&path).unwrap_err(),
+        LightsphereError::Decode { .. } | LightsphereError::Io { .. }
+    ));
+}
+
+#[cfg(unix)]
+#[test]
+fn fifos_and_devices_named_like_maps_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["sky.hdr", "sky.exr"] {
+        let fifo = dir.path().join(name);
+        let status = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let message = Environment::load(&fifo).unwrap_err().to_string();
+        assert!(
+            message.contains(name) && message.contains("FIFO"),
+            "{message}"
+        );
+    }
 }
 
 fn write_exr_rgba_f16(path: &Path, width: usize, height: usize) {

@@ -66,13 +66,14 @@ use std::path::Path;
 
 pub use error::MeshIoError;
 pub use gltf::{
-    GlbMesh, MAX_VIEWLESS_ELEMENTS, NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation,
+    GLTF_DECODE_FLOOR, GLTF_DECODE_PER_INPUT_BYTE, GlbMesh, MAX_VIEWLESS_ELEMENTS,
+    NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation,
 };
 pub use normals::{compute_normals, compute_normals_into};
 pub use npy::{NpyArray, read_npy_f32, write_npy_f32, write_npy_frames};
 pub use options::{
     AnimationOptions, ClipSelector, DEFAULT_FRAME_RATE, DEFAULT_MAX_FRAMES, LoadOptions,
-    NormalWeighting,
+    MAX_SAMPLED_BYTES, NormalWeighting,
 };
 pub use report::{
     AttributeStatus, ClipInfo, DegenerateKind, DegenerateTriangle, LoadReport, SourceFormat,

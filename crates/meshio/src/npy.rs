@@ -99,7 +99,7 @@ fn parse_string(s: &str) -> Option<(String, &str)> {
 /// [`MeshIoError::InvalidHeader`] for a bad magic or header dict, [`MeshIoError::Npy`] for an
 /// unsupported dtype or a data length that differs from the declared shape.
 pub fn read_npy_f32(path: &Path) -> Result<NpyArray, MeshIoError> {
-    let bytes = std::fs::read(path).map_err(|e| MeshIoError::io(path, "read", e))?;
+    let bytes = input_guard::read_regular(path).map_err(|e| MeshIoError::io(path, "read", e))?;
     if bytes.len() < 10 || !bytes.starts_with(MAGIC) {
         return Err(header_error(
             path,

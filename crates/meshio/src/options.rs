@@ -52,6 +52,11 @@ pub const DEFAULT_FRAME_RATE: f32 = 30.0;
 /// allocating terabytes.
 pub const DEFAULT_MAX_FRAMES: usize = 100_000;
 
+/// Upper bound on the positions sampled from one glTF clip, in bytes (frames × vertices × 12):
+/// 4 GiB. A short clip of a small file can ask for more (BrainStem, 34 159 vertices, is
+/// 0.4 MB per frame); a lower `frame_rate` or a shorter clip keeps it in bounds.
+pub const MAX_SAMPLED_BYTES: u64 = 4 << 30;
+
 /// Options for [`load_animation`](crate::load_animation).
 #[derive(Clone, Debug, PartialEq)]
 pub struct AnimationOptions {

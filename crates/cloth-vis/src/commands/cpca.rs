@@ -256,7 +256,7 @@ fn check_cpca_out(out: &Path) -> Result<(), Error> {
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, Error> {
-    std::fs::read(path).map_err(|e| Error::Io {
+    input_guard::read_regular(path).map_err(|e| Error::Io {
         path: path.to_owned(),
         reason: e.to_string(),
     })

@@ -7,7 +7,6 @@
 use super::{Environment, check_size};
 use crate::LightsphereError;
 use image::ImageDecoder;
-use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
@@ -51,13 +50,30 @@ fn decode_error(
 }
 
 fn load_hdr(path: &Path) -> Result<Environment, LightsphereError> {
-    let file = File::open(path).map_err(|e| io_error(path, "open", e))?;
+    let file = input_guard::open_regular(path).map_err(|e| io_error(path, "open", e))?;
+    let bytes_in_file = file
+        .metadata()
+        .map_err(|e| io_error(path, "stat", e))?
+        .len();
     // Reads and parses the header only.
     let decoder = image::codecs::hdr::HdrDecoder::new(BufReader::new(file))
         .map_err(|e| decode_error(path, HDR, e))?;
     let (width, height) = decoder.dimensions();
     let (width, height) = (width as usize, height as usize);
     check_size(Some(path), width, height)?;
+    let texels = (width as u64).saturating_mul(height as u64);
+    let backed = super::HDR_TEXELS_FLOOR
+        .saturating_add(bytes_in_file.saturating_mul(super::HDR_TEXELS_PER_BYTE));
+    if texels > backed {
+        return Err(LightsphereError::HdrHeaderTooLarge {
+            path: path.to_path_buf(),
+            width,
+            height,
+            bytes: bytes_in_file,
+            per_byte: super::HDR_TEXELS_PER_BYTE,
+            floor: super::HDR_TEXELS_FLOOR,
+        });
+    }
     let mut bytes = vec![0u8; width * height * 12];
     decoder
         .read_image(&mut bytes)
@@ -84,6 +100,8 @@ struct ExrPixels {
 }
 
 fn load_exr(path: &Path) -> Result<Environment, LightsphereError> {
+    // The exr crate opens by path: refuse a FIFO or a device first.
+    input_guard::open_regular(path).map_err(|e| io_error(path, "open", e))?;
     // Headers only: validate every RGB layer's size before decoding.
     let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
     let mut names = Vec::new();

@@ -26,6 +26,17 @@ pub const MAX_ENV_DIMENSION: usize = 32_768;
 /// Largest supported texel count (2^27 ≈ 134 M texels, 1.6 GB as `[f32; 3]`: a 16k × 8k map).
 pub const MAX_ENV_TEXELS: usize = 1 << 27;
 
+/// Texels any Radiance `.hdr` may claim whatever its size (2^22, a 2048 × 2048 map; 48 MB as
+/// `[f32; 3]`). Beyond it, the header must be backed by the file's bytes (resource policy,
+/// ARCHITECTURE.md): see [`HDR_TEXELS_PER_BYTE`].
+pub const HDR_TEXELS_FLOOR: u64 = 1 << 22;
+
+/// Texels per byte of file a Radiance `.hdr` may claim beyond [`HDR_TEXELS_FLOOR`]. Adaptive
+/// run-length encoding packs at most 127 texels of one channel into 2 bytes, 4 channels per
+/// texel, so a scanline holds at most ≈ 16 texels per byte; 32 leaves room for headers. (The
+/// pre-1991 "old" RLE can pack more; such files larger than the floor are refused.)
+pub const HDR_TEXELS_PER_BYTE: u64 = 32;
+
 /// A lat-long HDR environment map with a rotation relative to the world.
 ///
 /// # Examples

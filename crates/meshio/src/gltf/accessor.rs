@@ -145,6 +145,11 @@ fn read_exact(
             "integer matrices (with column padding) are not supported; store FLOAT matrices",
         ));
     }
+    // f64 values here, f32 in the caller: 12 bytes per value, taken before allocation.
+    let values_bytes = (count as u64)
+        .saturating_mul(components as u64)
+        .saturating_mul(12);
+    src.charge(what, values_bytes)?;
     let convert = |v: f64| {
         if accessor.normalized() {
             normalize(component, v)

@@ -27,6 +27,7 @@ pub use accessor::MAX_VIEWLESS_ELEMENTS;
 use rig::Rig;
 use sampler::Clip;
 use source::GltfSource;
+pub use source::{GLTF_DECODE_FLOOR, GLTF_DECODE_PER_INPUT_BYTE};
 pub use write::{GlbMesh, NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation};
 
 use crate::validate::{RawMesh, finish_animation, finish_mesh};
@@ -150,6 +151,22 @@ pub(crate) fn load_gltf_animation(
                     message: format!(
                         "clip {} spans {span} s, which at {rate} fps is {count} frames; lower frame_rate or raise max_frames",
                         animation.index()
+                    ),
+                });
+            }
+            let sampled_bytes = count * rig.vertex_count as f64 * 12.0;
+            if sampled_bytes > crate::MAX_SAMPLED_BYTES as f64 {
+                return Err(MeshIoError::InvalidOption {
+                    path: path.to_path_buf(),
+                    option: "frame_rate",
+                    value: options.frame_rate.to_string(),
+                    message: format!(
+                        "clip {} is {count} frames of {} vertices, {:.1} GB of positions, over \
+                         the limit of {} GB (meshio::MAX_SAMPLED_BYTES); lower the frame rate",
+                        animation.index(),
+                        rig.vertex_count,
+                        sampled_bytes / 1e9,
+                        crate::MAX_SAMPLED_BYTES as f64 / 1e9
                     ),
                 });
             }

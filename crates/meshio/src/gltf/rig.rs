@@ -335,7 +335,11 @@ fn read_primitive(
     for (t, target) in primitive.morph_targets().enumerate() {
         let dp = match target.positions() {
             Some(a) => read_vec3(src, &a, what)?,
-            None => vec![Vec3::ZERO; n],
+            None => {
+                // An empty target `{}` is legal; hundreds of them still allocate n each.
+                src.charge(what, (n as u64).saturating_mul(12))?;
+                vec![Vec3::ZERO; n]
+            }
         };
         check_len(dp.len(), &format!("morph target {t} POSITION"))?;
         let dn = target

@@ -11,12 +11,25 @@ use gltf::json::validation::Validate;
 
 use crate::MeshIoError;
 
+/// The decoded bytes any glTF may expand to, whatever its size (resource policy,
+/// ARCHITECTURE.md): 192 MiB.
+pub const GLTF_DECODE_FLOOR: u64 = 192 << 20;
+
+/// Beyond [`GLTF_DECODE_FLOOR`], decoded bytes allowed per byte of the file and its buffers.
+/// Accessors decode to at most 3× their bytes (f32 from 8-bit normalised data); repeated
+/// instances and viewless (sparse) accessors are what this bounds.
+pub const GLTF_DECODE_PER_INPUT_BYTE: u64 = 16;
+
 /// A parsed document and its buffer contents.
 pub(crate) struct GltfSource {
     pub path: PathBuf,
     pub document: gltf::Document,
     pub buffers: Vec<Vec<u8>>,
     pub is_glb: bool,
+    /// Bytes that decoding may still allocate (see [`GltfSource::charge`]).
+    budget: std::sync::atomic::AtomicU64,
+    /// The whole budget, for the message.
+    budget_total: u64,
 }
 
 impl GltfSource {
@@ -27,6 +40,35 @@ impl GltfSource {
         message: impl Into<String>,
     ) -> MeshIoError {
         gltf_error(&self.path, element, message)
+    }
+
+    /// Takes `bytes` from the decode budget before they are allocated. Nothing in a glTF
+    /// bounds what an accessor without a buffer view, a mesh instantiated by many nodes or
+    /// hundreds of empty morph targets expand to, so the budget does: the floor plus a multiple
+    /// of the input's size.
+    ///
+    /// # Errors
+    /// [`MeshIoError::Gltf`] naming `element`, the bytes asked and the budget.
+    pub(crate) fn charge(&self, element: &str, bytes: u64) -> Result<(), MeshIoError> {
+        use std::sync::atomic::Ordering;
+        let taken = self
+            .budget
+            .fetch_update(Ordering::Relaxed, Ordering::Relaxed, |left| {
+                left.checked_sub(bytes)
+            });
+        taken.map(|_| ()).map_err(|_| {
+            self.error(
+                element,
+                format!(
+                    "decoding it would exceed the {} MB this file may decode to ({} MB, plus \
+                     {GLTF_DECODE_PER_INPUT_BYTE} bytes per byte of the file and its buffers); \
+                     repeated mesh instances, morph targets or accessors without a buffer \
+                     view expand to more than a real asset does",
+                    self.budget_total >> 20,
+                    GLTF_DECODE_FLOOR >> 20
+                ),
+            )
+        })
     }
 }
 
@@ -44,7 +86,7 @@ pub(crate) fn gltf_error(
 
 /// Reads and validates `path` and loads its buffers.
 pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
-    let bytes = std::fs::read(path).map_err(|e| MeshIoError::io(path, "read", e))?;
+    let bytes = input_guard::read_regular(path).map_err(|e| MeshIoError::io(path, "read", e))?;
     let is_glb = bytes.starts_with(b"glTF");
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| gltf_error(path, "file", format!("cannot parse: {e}; is it glTF 2.0?")))?;
@@ -77,11 +119,16 @@ pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
         }
         buffers.push(data);
     }
+    let input_bytes = bytes.len() as u64 + buffers.iter().map(|b| b.len() as u64).sum::<u64>();
+    let budget_total =
+        GLTF_DECODE_FLOOR.saturating_add(input_bytes.saturating_mul(GLTF_DECODE_PER_INPUT_BYTE));
     Ok(GltfSource {
         path: path.to_path_buf(),
         document: gltf.document,
         buffers,
         is_glb,
+        budget: std::sync::atomic::AtomicU64::new(budget_total),
+        budget_total,
     })
 }
 
@@ -124,7 +171,8 @@ fn validate(path: &Path, root: &gltf::json::Root) -> Result<(), MeshIoError> {
     ))
 }
 
-/// Loads a buffer URI: a base64 `data:` URI or a path relative to the document.
+/// Loads a buffer URI: a base64 `data:` URI (bounded by the document's own size) or a path
+/// relative to the document that stays inside its folder.
 fn read_uri(path: &Path, base: &Path, element: &str, uri: &str) -> Result<Vec<u8>, MeshIoError> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let Some((_, payload)) = rest.split_once(";base64,") else {
@@ -151,8 +199,11 @@ fn read_uri(path: &Path, base: &Path, element: &str, uri: &str) -> Result<Vec<u8
             format!("URI {uri:?} has an invalid %-escape"),
         )
     })?;
-    let file = base.join(relative);
-    std::fs::read(&file).map_err(|e| MeshIoError::io(&file, "read", e))
+    // Only files inside the asset's folder: `/etc/passwd` or `../../x` must not be read
+    // into vertex positions, nor `/dev/zero` read until memory runs out.
+    let file = input_guard::confined_join(base, &relative)
+        .map_err(|e| gltf_error(path, element, e.to_string()))?;
+    input_guard::read_regular(&file).map_err(|e| MeshIoError::io(&file, "read", e))
 }
 
 /// Decodes `%XX` escapes; `None` for a malformed escape or non-UTF-8 result.

@@ -77,7 +77,7 @@ fn frame_files(dir: &Path, report: &mut LoadReport) -> Result<Vec<PathBuf>, Mesh
 }
 
 fn parse_frame(path: &Path) -> Result<(ObjData, LoadReport), MeshIoError> {
-    let data = std::fs::read(path).map_err(|e| MeshIoError::io(path, "read", e))?;
+    let data = input_guard::read_regular(path).map_err(|e| MeshIoError::io(path, "read", e))?;
     let mut report = LoadReport::default();
     let obj = parse_obj(path, &data, &mut report)?;
     Ok((obj, report))

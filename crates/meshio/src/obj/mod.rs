@@ -18,7 +18,7 @@ pub(crate) fn load_obj(
     path: &Path,
     options: &LoadOptions,
 ) -> Result<(Mesh, LoadReport), MeshIoError> {
-    let data = std::fs::read(path).map_err(|e| MeshIoError::io(path, "read", e))?;
+    let data = input_guard::read_regular(path).map_err(|e| MeshIoError::io(path, "read", e))?;
     let mut report = LoadReport::new(path, SourceFormat::Obj);
     let obj = parse_obj(path, &data, &mut report)?;
     let raw = into_raw(obj, &mut report);

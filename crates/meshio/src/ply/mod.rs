@@ -23,7 +23,7 @@ pub(crate) fn load_ply(
     path: &Path,
     options: &LoadOptions,
 ) -> Result<(Mesh, LoadReport), MeshIoError> {
-    let data = std::fs::read(path).map_err(|e| MeshIoError::io(path, "read", e))?;
+    let data = input_guard::read_regular(path).map_err(|e| MeshIoError::io(path, "read", e))?;
     let (raw, report) = parse_ply(path, &data)?;
     finish_mesh(path, raw, options, report)
 }
