@@ -15,6 +15,11 @@
 //!    receives SIGINT (Ctrl-C) or SIGTERM, then exits with status 130. Libraries never install
 //!    signal handlers: that is the binary's decision.
 //!
+//! Folder outputs (numbered frames, image sets) go through [`write_dir`]: a hidden temporary
+//! folder beside the target, renamed into place when complete, removed on error and on the
+//! same signals; an existing folder that holds files is refused unless the caller replaces it
+//! ([`ExistingFolder`]).
+//!
 //! [`write_with`] hands the caller a buffered writer; [`write_bytes`] writes a slice;
 //! [`write_via_path`] is for encoders that insist on opening a path themselves (the `image`
 //! crate's `save`, `exr`'s `to_file`). Errors are [`WriteError`] (which step failed, on which
@@ -35,11 +40,13 @@
 //! ```
 
 mod error;
+mod folder;
 mod signal;
 mod temporary;
 mod write;
 
 pub use error::{AtomicError, SignalError, WriteError};
+pub use folder::{ExistingFolder, write_dir};
 pub use signal::remove_temporaries_on_signal;
 pub use temporary::registered_temporaries;
 pub use write::{write_bytes, write_via_path, write_with};

@@ -49,8 +49,13 @@ fn remove_temporaries_and_exit() {
     // temporary file after this sweep, since creation takes the same lock.
     let registry = registry();
     for path in registry.iter() {
-        // Best effort: a file renamed onto its target a moment ago is simply gone.
-        let _ = std::fs::remove_file(path);
+        // Best effort: a file renamed onto its target a moment ago is simply gone. Temporary
+        // folders (`write_dir`) go with their contents.
+        if path.is_dir() {
+            let _ = std::fs::remove_dir_all(path);
+        } else {
+            let _ = std::fs::remove_file(path);
+        }
     }
     std::process::exit(EXIT_STATUS_ON_SIGNAL);
 }

@@ -1,5 +1,7 @@
 //! Named hard cases: every way an atomic write can fail leaves the target as it was and no
-//! temporary file behind — including a SIGTERM in the middle of a write.
+//! temporary file behind — including a SIGTERM in the middle of a write, inside a folder
+//! output under construction; folder outputs that would mix old files with new ones are
+//! refused, replaced only on request, and never left half-built.
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
@@ -8,8 +10,8 @@ use std::sync::{Arc, Barrier, mpsc};
 use std::time::{Duration, Instant};
 
 use atomic_out::{
-    AtomicError, WriteError, registered_temporaries, remove_temporaries_on_signal, write_bytes,
-    write_via_path, write_with,
+    AtomicError, ExistingFolder, WriteError, registered_temporaries, remove_temporaries_on_signal,
+    write_bytes, write_dir, write_via_path, write_with,
 };
 
 /// How long the signal test waits for its child process at each step before failing (it takes
@@ -215,13 +217,13 @@ fn sigterm_mid_write_removes_the_temporary_and_exits_130() {
         }
     });
     let deadline = Instant::now() + CHILD_TIMEOUT;
-    let temporary = loop {
+    let temporaries: Vec<PathBuf> = loop {
         let line = received.recv_timeout(deadline.saturating_duration_since(Instant::now()));
         match line {
             Ok(Ok(line)) => {
                 // libtest prints `test NAME ... ` on the same line before it.
-                if let Some((_, path)) = line.split_once("TEMPORARY ") {
-                    break PathBuf::from(path);
+                if let Some((_, paths)) = line.split_once("TEMPORARIES ") {
+                    break paths.split('|').map(PathBuf::from).collect();
                 }
             }
             _ => {
@@ -230,7 +232,12 @@ fn sigterm_mid_write_removes_the_temporary_and_exits_130() {
             }
         }
     };
-    assert!(temporary.exists(), "{}", temporary.display());
+    // The temporary folder of a frame folder, and a temporary file being written inside it.
+    assert_eq!(temporaries.len(), 2, "{temporaries:?}");
+    assert!(temporaries.iter().any(|t| t.is_dir()), "{temporaries:?}");
+    for temporary in &temporaries {
+        assert!(temporary.exists(), "{}", temporary.display());
+    }
     let kill = Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
         .status()
@@ -238,7 +245,9 @@ fn sigterm_mid_write_removes_the_temporary_and_exits_130() {
     assert!(kill.success());
     let status = wait_with_timeout(&mut child);
     assert_eq!(status.code(), Some(130), "{status}");
-    assert!(!temporary.exists(), "{} was left", temporary.display());
+    for temporary in &temporaries {
+        assert!(!temporary.exists(), "{} was left", temporary.display());
+    }
     assert!(entries(dir.path()).is_empty(), "{:?}", entries(dir.path()));
 }
 
@@ -252,16 +261,22 @@ fn sigterm_child_blocks_mid_write() {
     };
     remove_temporaries_on_signal().unwrap();
     remove_temporaries_on_signal().unwrap();
-    let result = write_with(&dir.join("interrupted.bin"), |w| {
-        w.write_all(&[1; 100_000])?;
-        w.flush()?;
-        let [temporary] = registered_temporaries().try_into().unwrap();
-        println!("TEMPORARY {}", temporary.display());
-        let deadline = Instant::now() + CHILD_TIMEOUT;
-        while Instant::now() < deadline {
-            std::thread::sleep(Duration::from_millis(5));
-        }
-        Err(std::io::Error::other("no signal arrived"))
+    let result = write_dir(&dir.join("frames"), ExistingFolder::Refuse, |folder| {
+        std::fs::write(folder.join("frame_00000.obj"), "v 0 0 0\n").unwrap();
+        write_with(&folder.join("frame_00001.obj"), |w| {
+            w.write_all(&[1; 100_000])?;
+            w.flush()?;
+            let names: Vec<String> = registered_temporaries()
+                .iter()
+                .map(|t| t.display().to_string())
+                .collect();
+            println!("TEMPORARIES {}", names.join("|"));
+            let deadline = Instant::now() + CHILD_TIMEOUT;
+            while Instant::now() < deadline {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            Err(std::io::Error::other("no signal arrived"))
+        })
     });
     panic!("the write returned without a signal: {result:?}");
 }
@@ -287,4 +302,88 @@ fn foreign_handler_child_installs_first() {
     let err = remove_temporaries_on_signal().unwrap_err();
     assert!(err.to_string().contains("registered_temporaries"), "{err}");
     assert!(std::error::Error::source(&err).is_some());
+}
+
+#[test]
+fn a_folder_output_appears_complete_or_not_at_all() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = dir.path().join("frames");
+    // A failure half-way leaves nothing: no target, no temporary folder.
+    let err = write_dir(&frames, ExistingFolder::Refuse, |tmp| {
+        std::fs::write(tmp.join("frame_00000.obj"), "v 0 0 0\n")?;
+        Err(std::io::Error::other("disk full at frame 1"))
+    })
+    .unwrap_err();
+    assert!(matches!(err, AtomicError::Writer(_)), "{err}");
+    assert!(entries(dir.path()).is_empty(), "{:?}", entries(dir.path()));
+    assert!(registered_in(dir.path()).is_empty());
+    // Success: the folder appears with its files; an empty existing folder gives way.
+    std::fs::create_dir(&frames).unwrap();
+    write_dir(&frames, ExistingFolder::Refuse, |tmp| {
+        for f in 0..3 {
+            std::fs::write(tmp.join(format!("frame_{f:05}.obj")), "v 0 0 0\n")?;
+        }
+        Ok::<(), std::io::Error>(())
+    })
+    .unwrap();
+    assert_eq!(entries(&frames).len(), 3);
+    assert_eq!(entries(dir.path()), ["frames"]);
+    // A folder with files is refused before any work: stale frames would sit beside new ones.
+    let mut called = false;
+    let err = write_dir(&frames, ExistingFolder::Refuse, |_| {
+        called = true;
+        Ok::<(), std::io::Error>(())
+    })
+    .unwrap_err();
+    assert!(!called);
+    let message = err.to_string();
+    assert!(
+        message.contains("frames") && message.contains("--force"),
+        "{message}"
+    );
+    // Replaced on request: only the new (shorter) clip remains.
+    write_dir(&frames, ExistingFolder::Replace, |tmp| {
+        std::fs::write(tmp.join("frame_00000.obj"), "v 1 1 1\n")
+    })
+    .unwrap();
+    assert_eq!(entries(&frames), ["frame_00000.obj"]);
+    assert_eq!(entries(dir.path()), ["frames"], "the old folder is gone");
+    // A file where the folder should go, and a missing parent, are errors naming the target.
+    let file = dir.path().join("file");
+    std::fs::write(&file, "x").unwrap();
+    let message = write_dir(&file, ExistingFolder::Replace, |_| {
+        Ok::<(), std::io::Error>(())
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(
+        message.contains("file") && message.contains("not a readable folder"),
+        "{message}"
+    );
+    let missing = dir.path().join("missing/frames");
+    assert!(
+        write_dir(
+            &missing,
+            ExistingFolder::Refuse,
+            |_| Ok::<(), std::io::Error>(())
+        )
+        .is_err()
+    );
+    assert_eq!(entries(dir.path()), ["file", "frames"]);
+}
+
+#[test]
+fn a_panic_while_filling_a_folder_removes_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = dir.path().join("frames");
+    let result = std::panic::catch_unwind(|| {
+        write_dir(&frames, ExistingFolder::Refuse, |tmp| {
+            std::fs::write(tmp.join("frame_00000.obj"), "v 0 0 0\n").unwrap();
+            panic!("bug in the writer");
+            #[allow(unreachable_code)]
+            Ok::<(), std::io::Error>(())
+        })
+    });
+    assert!(result.is_err());
+    assert!(entries(dir.path()).is_empty(), "{:?}", entries(dir.path()));
 }

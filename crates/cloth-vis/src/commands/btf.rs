@@ -175,18 +175,7 @@ fn dir_bytes(dir: &Path) -> u64 {
 /// parameters ([`Error::Synth`]); write errors. On error nothing is left at `out`.
 pub fn run_synth(request_: &SynthRequest) -> Result<SynthSummary, Error> {
     let out = &request_.out;
-    if out.exists() {
-        let empty = std::fs::read_dir(out)
-            .map(|mut d| d.next().is_none())
-            .unwrap_or(false);
-        if !empty {
-            return Err(request(
-                out,
-                "exists and is not an empty folder; choose a new folder for the BTF images"
-                    .to_owned(),
-            ));
-        }
-    }
+    let existing = super::folder_output(out, false)?;
     let woven = synth::WovenBtf::new(&request_.params)?;
     let start = Instant::now();
     let parent = out
@@ -197,26 +186,14 @@ pub fn run_synth(request_: &SynthRequest) -> Result<SynthSummary, Error> {
         path: parent.to_owned(),
         reason: format!("cannot create the folder: {e}"),
     })?;
-    let name = out
-        .file_name()
-        .map_or_else(|| "btf".into(), |n| n.to_string_lossy().into_owned());
-    let temp = parent.join(format!(".{name}.partial-{}", std::process::id()));
-    let result = write_views(&woven, request_, &temp);
-    if let Err(e) = result {
-        let _ = std::fs::remove_dir_all(&temp);
-        return Err(e);
-    }
-    if out.exists() {
-        // An empty folder (checked above) gives way to the complete one.
-        let _ = std::fs::remove_dir(out);
-    }
-    std::fs::rename(&temp, out).map_err(|e| {
-        let _ = std::fs::remove_dir_all(&temp);
-        Error::Io {
-            path: out.clone(),
-            reason: format!("cannot move the finished folder into place: {e}"),
-        }
-    })?;
+    // Built in a hidden folder beside `out` and renamed into place when all 6,561 images are
+    // written; removed on error and on SIGINT/SIGTERM.
+    atomic_out::write_dir(out, existing, |temp| write_views(&woven, request_, temp)).map_err(
+        |e| match e {
+            atomic_out::AtomicError::Writer(e) => e,
+            atomic_out::AtomicError::File(e) => Error::from(e),
+        },
+    )?;
     Ok(SynthSummary {
         res: woven.res(),
         sampling: request_.sampling,

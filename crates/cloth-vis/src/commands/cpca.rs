@@ -118,6 +118,8 @@ pub struct DecompressRequest {
     /// `.npy` ([F, V, 3] f32), `.glb` (morph-target animation) or a folder (no extension) of
     /// `frame_00000.obj` …
     pub out: PathBuf,
+    /// Replace an output folder that holds files (else refused before any work).
+    pub force: bool,
 }
 
 /// What `decompress` wrote.
@@ -216,11 +218,13 @@ fn worst_frame(d: &Distortion) -> (usize, f64) {
 enum OutKind {
     Npy,
     Glb,
-    ObjFolder,
+    /// With what to do about an existing folder.
+    ObjFolder(atomic_out::ExistingFolder),
 }
 
-/// The output kind `out` names, or an error naming it and the supported kinds.
-fn out_kind(out: &Path) -> Result<OutKind, Error> {
+/// The output kind `out` names, or an error naming it and the supported kinds; an OBJ folder
+/// that holds files is refused unless `force`.
+fn out_kind(out: &Path, force: bool) -> Result<OutKind, Error> {
     match out
         .extension()
         .and_then(|e| e.to_str())
@@ -229,7 +233,7 @@ fn out_kind(out: &Path) -> Result<OutKind, Error> {
     {
         Some("npy") => Ok(OutKind::Npy),
         Some("glb") => Ok(OutKind::Glb),
-        None => Ok(OutKind::ObjFolder),
+        None => Ok(OutKind::ObjFolder(super::folder_output(out, force)?)),
         Some(other) => Err(invalid(
             out,
             format!(
@@ -343,7 +347,7 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
 /// message prefixed with its path); a `.glb` output of a file without triangles; write errors
 /// naming the output. Nothing is written on error.
 pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, Error> {
-    let kind = out_kind(&request.out)?;
+    let kind = out_kind(&request.out, request.force)?;
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
     let (data, _) = read_cpca(&request.input)?;
     if kind == OutKind::Glb && data.triangles().is_empty() {
@@ -567,9 +571,13 @@ fn write_frames(
             };
             meshio::write_glb_animation(out, &animation)?;
         }
-        OutKind::ObjFolder => {
-            super::jumpmap::write_obj_frames(out, &frames, triangles, "cloth-vis anim decompress")?
-        }
+        OutKind::ObjFolder(existing) => super::jumpmap::write_obj_frames(
+            out,
+            existing,
+            &frames,
+            triangles,
+            "cloth-vis anim decompress",
+        )?,
     }
     Ok(())
 }
@@ -659,6 +667,9 @@ pub struct DecompressArgs {
     /// Output: FILE.npy, FILE.glb or a folder name (OBJ frames).
     #[arg(long)]
     out: PathBuf,
+    /// Replace an existing output folder that holds files, once the new frames are complete.
+    #[arg(long)]
+    force: bool,
 }
 
 impl DecompressArgs {
@@ -667,6 +678,7 @@ impl DecompressArgs {
         let request = DecompressRequest {
             input: self.input,
             out: self.out,
+            force: self.force,
         };
         super::print_line(&run_decompress(&request)?.line())
     }

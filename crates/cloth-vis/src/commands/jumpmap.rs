@@ -70,6 +70,8 @@ pub struct JumpMapRequest {
     pub frames: usize,
     /// `.npy`, `.glb`, or a folder (no extension) of `frame_00000.obj` …
     pub out: PathBuf,
+    /// Replace an output folder that holds files (else refused before any work).
+    pub force: bool,
     /// Folder for the heat maps `D.png`, `D_velocity.png`, `P.png`, `P_velocity.png`,
     /// `P_hat.png` (`None`: none written).
     pub maps: Option<PathBuf>,
@@ -120,7 +122,8 @@ pub const MAX_GENERATED_BYTES: u64 = 4_000_000_000;
 enum OutKind {
     Npy,
     Glb,
-    ObjFolder,
+    /// With what to do about an existing folder.
+    ObjFolder(atomic_out::ExistingFolder),
 }
 
 /// Runs the request. `gpu` is needed only for [`JumpMapRequest::strip`].
@@ -147,7 +150,7 @@ pub fn run_jumpmap(
     {
         Some("npy") => OutKind::Npy,
         Some("glb") => OutKind::Glb,
-        None => OutKind::ObjFolder,
+        None => OutKind::ObjFolder(super::folder_output(out, request.force)?),
         Some(other) => {
             return Err(invalid(
                 out,
@@ -357,8 +360,9 @@ pub fn run_jumpmap(
             };
             meshio::write_glb_animation(out, &animation)?;
         }
-        OutKind::ObjFolder => write_obj_frames(
+        OutKind::ObjFolder(existing) => write_obj_frames(
             out,
+            existing,
             &frames,
             &clip.triangles,
             "cloth-vis anim jumpmap, generated",
@@ -375,21 +379,22 @@ pub fn run_jumpmap(
     })
 }
 
-/// Numbered OBJ frames `frame_00000.obj` … in `dir` (created), each written atomically, with
-/// the comment line `# {what}, frame N`.
+/// Numbered OBJ frames `frame_00000.obj` … in the folder `dir`, with the comment line
+/// `# {what}, frame N`: built in a temporary folder beside it and renamed into place when every
+/// frame is written (`atomic_out::write_dir`), so an interrupted run leaves no shorter clip
+/// that looks complete; `existing` says what happens to a folder that holds files.
 pub(crate) fn write_obj_frames(
     dir: &Path,
+    existing: atomic_out::ExistingFolder,
     frames: &[Vec<Vec3>],
     triangles: &[[u32; 3]],
     what: &str,
 ) -> Result<(), Error> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-        path: dir.to_owned(),
-        reason: e.to_string(),
-    })?;
-    for (f, positions) in frames.iter().enumerate() {
-        let path = dir.join(format!("frame_{f:05}.obj"));
-        atomic_out::write_with(&path, |w| {
+    atomic_out::write_dir(dir, existing, |tmp| {
+        for (f, positions) in frames.iter().enumerate() {
+            let path = tmp.join(format!("frame_{f:05}.obj"));
+            let file = std::fs::File::create(&path)?;
+            let mut w = std::io::BufWriter::new(file);
             writeln!(w, "# {what}, frame {f}")?;
             for p in positions {
                 writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
@@ -397,10 +402,14 @@ pub(crate) fn write_obj_frames(
             for t in triangles {
                 writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
             }
-            Ok(())
-        })?;
-    }
-    Ok(())
+            w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        }
+        Ok::<(), std::io::Error>(())
+    })
+    .map_err(|e| Error::Io {
+        path: dir.to_owned(),
+        reason: e.to_string(),
+    })
 }
 
 /// The five matrices of the analysis as heat maps, one pixel per entry (scaled up to at least
@@ -555,6 +564,9 @@ pub struct JumpmapArgs {
     /// Output: FILE.npy, FILE.glb or a folder name (OBJ frames).
     #[arg(long)]
     out: PathBuf,
+    /// Replace an existing output folder that holds files, once the new frames are complete.
+    #[arg(long)]
+    force: bool,
     /// Folder for the heat maps of D, D*, P, P*, P̂ (PNG).
     #[arg(long)]
     maps: Option<PathBuf>,
@@ -613,6 +625,7 @@ impl JumpmapArgs {
             },
             frames: self.frames,
             out: self.out,
+            force: self.force,
             maps: self.maps,
             strip: self.strip.map(|path| StripRequest {
                 path,

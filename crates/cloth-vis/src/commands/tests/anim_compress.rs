@@ -181,11 +181,33 @@ fn time_compression_and_obj_folder_output() {
     );
     assert!(summary.distortion.da.is_finite());
     let folder = dir.path().join("frames");
+    // Issue #12: decompressing into a folder that held older frames left stale frames beside
+    // the new ones. A folder with files is now refused before any work, and replaced whole
+    // with --force.
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::write(folder.join("frame_99999.obj"), "stale").unwrap();
+    let refused = run_decompress(&DecompressRequest {
+        input: cpca.clone(),
+        out: folder.clone(),
+        force: false,
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(refused.contains("--force"), "{refused}");
+    assert_eq!(std::fs::read_dir(&folder).unwrap().count(), 1);
     run_decompress(&DecompressRequest {
         input: cpca.clone(),
         out: folder.clone(),
+        force: true,
     })
     .unwrap();
+    assert!(!folder.join("frame_99999.obj").exists(), "the stale frame is gone");
+    let beside: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(beside.is_empty(), "no temporary folder is left: {beside:?}");
     // The clip came from .npy, so the frames are vertex-only OBJ (which meshio's loader
     // refuses as an animation): read the `v` lines directly.
     let expected =
@@ -301,6 +323,7 @@ fn unsupported_outputs_are_refused_before_any_work() {
     let err = run_decompress(&DecompressRequest {
         input: cpca.clone(),
         out: glb.clone(),
+        force: false,
     })
     .unwrap_err()
     .to_string();

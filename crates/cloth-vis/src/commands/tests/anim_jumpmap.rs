@@ -65,6 +65,7 @@ fn request(input: PathBuf, out: PathBuf) -> JumpMapRequest {
         },
         frames: 200,
         out,
+        force: false,
         maps: None,
         strip: None,
     }
