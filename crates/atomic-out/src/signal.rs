@@ -52,10 +52,30 @@ fn remove_temporaries_and_exit() {
         // Best effort: a file renamed onto its target a moment ago is simply gone. Temporary
         // folders (`write_dir`) go with their contents.
         if path.is_dir() {
-            let _ = std::fs::remove_dir_all(path);
+            remove_folder_being_written(path);
         } else {
             let _ = std::fs::remove_file(path);
         }
     }
     std::process::exit(EXIT_STATUS_ON_SIGNAL);
+}
+
+/// Removes a temporary folder that another thread may still be writing into. It is first
+/// renamed, so that the writer's next file creation (by the old path) fails instead of adding
+/// to it; a creation already under way can still land, so the removal is retried.
+fn remove_folder_being_written(path: &std::path::Path) {
+    let mut doomed = path.as_os_str().to_owned();
+    doomed.push(".removing");
+    let doomed = std::path::PathBuf::from(doomed);
+    let target = if std::fs::rename(path, &doomed).is_ok() {
+        doomed
+    } else {
+        path.to_path_buf()
+    };
+    for _ in 0..100 {
+        if std::fs::remove_dir_all(&target).is_ok() || !target.exists() {
+            return;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
 }
