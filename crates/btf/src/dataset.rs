@@ -71,6 +71,31 @@ fn check_image_size(path: &Path, width: usize, height: usize) -> Result<()> {
     Ok(())
 }
 
+/// Reads one normtexture file (PNG, JPEG or EXR) as linear RGB under the same rules as
+/// [`BtfDir::open`] and [`BtfDir::load_view`]: regular files only, the header's size checked
+/// against [`MAX_NORMTEXTURE_SIDE`] (and, for PNG, against what the file's bytes can hold)
+/// before anything of that size is allocated, 8- and 16-bit values through the sRGB transfer
+/// function, NaN/∞ refused. Returns width, height and 3·w·h floats, row-major.
+///
+/// # Errors
+/// [`BtfError::Io`], [`BtfError::Codec`], [`BtfError::ImageTooLarge`],
+/// [`BtfError::NonFinite`], each naming the file.
+pub fn read_image(path: &Path) -> Result<(usize, usize, Vec<f32>)> {
+    let (width, height) = read_dimensions(path)?;
+    if width == 0 || height == 0 {
+        return Err(BtfError::codec(
+            path,
+            "read the header of",
+            "the image is empty",
+        ));
+    }
+    check_image_size(path, width, height)?;
+    let mut out = vec![0.0f32; 3 * width * height];
+    decode_into(path, width, height, &mut out)?;
+    check_finite(&out, || path.display().to_string())?;
+    Ok((width, height, out))
+}
+
 /// Number of (view, light) pairs: 81 × 81 = 6,561 images.
 pub(crate) const fn pair_count() -> usize {
     DIRECTIONS * DIRECTIONS

@@ -77,7 +77,7 @@ pub mod stats;
 
 pub use compare::{AbrdfMatrix, TexelModel};
 pub use compress::{BtfPcaParams, CompressReport, DEFAULT_COMPONENTS, MAX_COMPONENTS, SlotReport};
-pub use dataset::{BtfDir, MAX_NORMTEXTURE_SIDE, ViewSlot, image_file_name};
+pub use dataset::{BtfDir, MAX_NORMTEXTURE_SIDE, ViewSlot, image_file_name, read_image};
 pub use error::{BtfError, CodecError, Result};
 pub use io::{
     linear_to_srgb, linear_to_srgb8, srgb_to_linear, write_btf_dir, write_btf_view, write_png_srgb8,

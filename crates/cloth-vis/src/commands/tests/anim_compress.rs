@@ -201,7 +201,10 @@ fn time_compression_and_obj_folder_output() {
         force: true,
     })
     .unwrap();
-    assert!(!folder.join("frame_99999.obj").exists(), "the stale frame is gone");
+    assert!(
+        !folder.join("frame_99999.obj").exists(),
+        "the stale frame is gone"
+    );
     let beside: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
