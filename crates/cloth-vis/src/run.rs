@@ -119,10 +119,15 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         Some(range) => Some(range),
         None => scene.frame_range()?,
     };
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::Io {
-        path: out_dir.to_owned(),
-        reason: e.to_string(),
-    })?;
+    // The folder itself is created only after the inputs have loaded (below): a run that
+    // fails on a corrupt mesh or a missing adapter leaves nothing behind.
+    if out_dir.exists() && !out_dir.is_dir() {
+        return Err(Error::Io {
+            path: out_dir.to_owned(),
+            reason: "exists and is not a folder; the run writes its images into a folder"
+                .to_owned(),
+        });
+    }
     let gpu = GpuContext::new(&options.gpu)?;
     let mut timer = Timer { stages: Vec::new() };
 
@@ -165,6 +170,10 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         samples: format.samples,
     };
 
+    std::fs::create_dir_all(out_dir).map_err(|e| Error::Io {
+        path: out_dir.to_owned(),
+        reason: e.to_string(),
+    })?;
     let mut outputs = Vec::new();
     let image = match frames {
         None => {
