@@ -400,11 +400,7 @@ fn a_fifo_named_like_an_image_is_refused_not_waited_on() {
         .path()
         .join(btf::image_file_name(Sampling::H1, 3, 5, "png"));
     std::fs::remove_file(&victim).unwrap();
-    let status = std::process::Command::new("mkfifo")
-        .arg(&victim)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    test_data::make_fifo(&victim);
     let message = btf::BtfDir::open(dir.path()).unwrap_err().to_string();
     assert!(message.contains("FIFO"), "{message}");
     assert!(

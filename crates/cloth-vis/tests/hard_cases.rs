@@ -177,11 +177,7 @@ fn a_sky_too_wide_for_any_use_is_refused_by_key_before_any_work() {
 fn a_scene_file_that_is_a_fifo_is_refused_by_name() {
     let dir = tempfile::tempdir().unwrap();
     let fifo = dir.path().join("scene.toml");
-    let status = std::process::Command::new("mkfifo")
-        .arg(&fifo)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    test_data::make_fifo(&fifo);
     let message = Scene::load(&fifo).unwrap_err().to_string();
     assert!(
         message.contains("scene.toml") && message.contains("FIFO"),

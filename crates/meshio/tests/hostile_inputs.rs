@@ -261,13 +261,7 @@ fn fifos_are_refused_by_name_without_hanging() {
     let dir = tempfile::tempdir().unwrap();
     let mkfifo = |name: &str| {
         let path = dir.path().join(name);
-        assert!(
-            std::process::Command::new("mkfifo")
-                .arg(&path)
-                .status()
-                .unwrap()
-                .success()
-        );
+        test_data::make_fifo(&path);
         path
     };
     for name in ["mesh.ply", "mesh.obj", "mesh.glb", "frames.npy"] {

@@ -79,3 +79,17 @@ pub fn skip<T>(reason: &str) -> Option<T> {
 pub fn skipped_so_far() -> usize {
     SKIPS.load(std::sync::atomic::Ordering::Relaxed)
 }
+
+/// Creates a FIFO (named pipe) at `path` with the system's `mkfifo`, for the tests that check
+/// a reader refuses it instead of blocking on it (issue #12). Unix only.
+///
+/// # Panics
+/// When `mkfifo` cannot run or fails: the test cannot do what it means to.
+#[cfg(unix)]
+pub fn make_fifo(path: &std::path::Path) {
+    let status = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(status.success(), "mkfifo {} failed", path.display());
+}
