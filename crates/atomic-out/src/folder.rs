@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{AtomicError, WriteError};
-use crate::temporary::registry;
+use crate::temporary::{deregister, registry};
 
 /// Distinguishes the temporary folders of concurrent writes within one process.
 static COUNTER: AtomicU64 = AtomicU64::new(0);
@@ -138,10 +138,7 @@ impl Drop for TemporaryDir {
         if !self.renamed {
             let _ = std::fs::remove_dir_all(&self.path);
         }
-        let mut registry = registry();
-        if let Some(i) = registry.iter().position(|p| *p == self.path) {
-            registry.swap_remove(i);
-        }
+        deregister(&self.path);
     }
 }
 

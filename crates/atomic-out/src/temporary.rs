@@ -79,10 +79,15 @@ impl Drop for Temporary {
             // Best effort: the file may already be gone (removed by the caller's closure).
             let _ = std::fs::remove_file(&self.path);
         }
-        let mut registry = registry();
-        if let Some(i) = registry.iter().position(|p| *p == self.path) {
-            registry.swap_remove(i);
-        }
+        deregister(&self.path);
+    }
+}
+
+/// Removes `path` from the registry (a temporary file or folder that is gone or in place).
+pub(crate) fn deregister(path: &Path) {
+    let mut registry = registry();
+    if let Some(i) = registry.iter().position(|p| p == path) {
+        registry.swap_remove(i);
     }
 }
 
