@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{AtomicError, WriteError};
+use crate::parents::CreatedParents;
 use crate::temporary::{deregister, registry};
 
 /// Distinguishes the temporary folders of concurrent writes within one process.
@@ -27,7 +28,8 @@ pub enum ExistingFolder {
 /// registered so that the signal handler of [`crate::remove_temporaries_on_signal`] removes it
 /// on SIGINT/SIGTERM). On success it is renamed to `target`: an empty existing `target` gives
 /// way; a non-empty one is refused before `fill` runs, or with [`ExistingFolder::Replace`]
-/// moved aside, replaced, and removed. On error or panic in `fill` the temporary folder is
+/// moved aside, replaced, and removed. Missing parent folders of `target` are created first.
+/// On error or panic in `fill` the temporary folder and the parents this call created are
 /// removed and `target` is untouched.
 ///
 /// # Errors
@@ -73,11 +75,14 @@ pub fn write_dir<E>(
              replace it once the new one is complete",
         )));
     }
+    let parents = CreatedParents::create(target).map_err(fail("create the folders of"))?;
     let temporary = TemporaryDir::create(target).map_err(fail("create a temporary folder for"))?;
     fill(&temporary.path).map_err(AtomicError::Writer)?;
     temporary
         .move_onto(target)
-        .map_err(fail("move the finished folder onto"))
+        .map_err(fail("move the finished folder onto"))?;
+    parents.keep();
+    Ok(())
 }
 
 /// A temporary folder: registered while it exists, removed with its contents on drop unless

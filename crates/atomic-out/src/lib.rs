@@ -8,11 +8,14 @@
 //!    `N` keep concurrent writers apart), created with `create_new`;
 //! 2. it is flushed, synced to disk and renamed over the target, which a reader sees either as
 //!    it was before or complete;
-//! 3. on any error — including a panic in the caller's closure — the temporary file is removed
-//!    and the target is left untouched;
+//! 3. missing parent folders are created (every writer, so `--out renders/a.png` behaves the
+//!    same in every command); on any error — including a panic in the caller's closure — the
+//!    temporary file and the folders this write created are removed and the target is left
+//!    untouched;
 //! 4. while a temporary file exists it is registered, and a binary that called
 //!    [`remove_temporaries_on_signal`] once at start removes every registered temporary when it
-//!    receives SIGINT (Ctrl-C) or SIGTERM, then exits with status 130. Libraries never install
+//!    receives SIGINT (Ctrl-C) or SIGTERM, and the (then empty) folders created for them, then
+//!    exits with status 130. Libraries never install
 //!    signal handlers: that is the binary's decision.
 //!
 //! Folder outputs (numbered frames, image sets) go through [`write_dir`]: a hidden temporary
@@ -41,6 +44,7 @@
 
 mod error;
 mod folder;
+mod parents;
 mod signal;
 mod temporary;
 mod write;

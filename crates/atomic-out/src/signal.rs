@@ -57,6 +57,10 @@ fn remove_temporaries_and_exit() {
             let _ = std::fs::remove_file(path);
         }
     }
+    // Then the parent folders created for them, innermost first, each only if empty.
+    for dir in crate::parents::created().iter().rev() {
+        let _ = std::fs::remove_dir(dir);
+    }
     std::process::exit(EXIT_STATUS_ON_SIGNAL);
 }
 

@@ -6,17 +6,19 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 use crate::error::{AtomicError, WriteError};
+use crate::parents::CreatedParents;
 use crate::temporary::Temporary;
 
 /// Writes `path` atomically: `write` fills a buffered writer on a new temporary file beside
 /// `path`, which is then flushed, synced to disk and renamed over `path`.
 ///
-/// On any error (or a panic in `write`) the temporary file is removed and `path` is left as it
+/// Missing parent folders of `path` are created first. On any error (or a panic in `write`)
+/// the temporary file and the folders this call created are removed and `path` is left as it
 /// was. An existing file at `path` is replaced.
 ///
 /// # Errors
-/// [`WriteError`] naming `path` and the step: `"create"` (the folder does not exist, or `path`
-/// names no file),
+/// [`WriteError`] naming `path` and the step: `"create the folders of"` (a parent cannot be
+/// created, or a file stands where a folder should), `"create"` (`path` names no file),
 /// `"write"` (including any error `write` returns), `"sync"`, or
 /// `"rename a temporary file onto"` (e.g. `path` is a folder).
 ///
@@ -39,6 +41,7 @@ pub fn write_with(
     write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>,
 ) -> Result<(), WriteError> {
     let fail = |op| move |e| WriteError::new(path, op, e);
+    let parents = CreatedParents::create(path).map_err(fail("create the folders of"))?;
     let (temporary, file) = Temporary::create(path).map_err(fail("create"))?;
     let mut writer = BufWriter::new(file);
     write(&mut writer).map_err(fail("write"))?;
@@ -50,7 +53,9 @@ pub fn write_with(
     drop(file);
     temporary
         .rename_onto(path)
-        .map_err(fail("rename a temporary file onto"))
+        .map_err(fail("rename a temporary file onto"))?;
+    parents.keep();
+    Ok(())
 }
 
 /// Writes `bytes` to `path` atomically; see [`write_with`].
@@ -74,12 +79,13 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), WriteError> {
 /// path of a new, empty temporary file beside `path` and writes (or replaces) it; the result is
 /// synced to disk and renamed over `path`.
 ///
-/// On any error (or a panic in `write`) the temporary file is removed and `path` is left as it
-/// was.
+/// Missing parent folders are created as for [`write_with`]. On any error (or a panic in
+/// `write`) the temporary file and those folders are removed and `path` is left as it was.
 ///
 /// # Errors
 /// [`AtomicError::Writer`] with `write`'s own error, unchanged;
-/// [`AtomicError::File`] with a [`WriteError`] as for [`write_with`] (`"create"`, `"sync"` —
+/// [`AtomicError::File`] with a [`WriteError`] as for [`write_with`] (`"create the folders
+/// of"`, `"create"`, `"sync"` —
 /// also when `write` removed the file — or `"rename a temporary file onto"`).
 ///
 /// # Examples
@@ -101,6 +107,7 @@ pub fn write_via_path<E>(
     write: impl FnOnce(&Path) -> Result<(), E>,
 ) -> Result<(), AtomicError<E>> {
     let fail = |op| move |e| AtomicError::File(WriteError::new(path, op, e));
+    let parents = CreatedParents::create(path).map_err(fail("create the folders of"))?;
     let (temporary, file) = Temporary::create(path).map_err(fail("create"))?;
     // The encoder opens the path itself; holding our handle open would only block it on
     // platforms that lock open files.
@@ -114,7 +121,9 @@ pub fn write_via_path<E>(
         .map_err(fail("sync"))?;
     temporary
         .rename_onto(path)
-        .map_err(fail("rename a temporary file onto"))
+        .map_err(fail("rename a temporary file onto"))?;
+    parents.keep();
+    Ok(())
 }
 
 #[cfg(test)]
@@ -139,6 +148,20 @@ mod tests {
         write_with(&path, |w| w.write_all(b"new")).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"new");
         assert_eq!(entries(dir.path()), ["a.txt"]);
+    }
+
+    #[test]
+    fn missing_parent_folders_are_created_and_removed_again_on_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("renders/run 1/a.txt");
+        let err = write_with(&path, |_| Err(std::io::Error::other("no"))).unwrap_err();
+        assert_eq!(err.op, "write");
+        assert!(entries(dir.path()).is_empty(), "{:?}", entries(dir.path()));
+        write_bytes(&path, b"yes").unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"yes");
+        let err = write_via_path(&dir.path().join("x/y/z.exr"), |_| Err("encoder")).unwrap_err();
+        assert!(matches!(err, AtomicError::Writer("encoder")));
+        assert_eq!(entries(dir.path()), ["renders"]);
     }
 
     #[test]

@@ -58,18 +58,30 @@ fn writer_failing_midway_keeps_the_old_target_and_leaves_no_temporary() {
 }
 
 #[test]
-fn missing_folder_is_a_create_error_naming_the_target() {
+fn missing_folders_are_created_and_a_file_in_their_place_is_an_error_naming_the_target() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("missing").join("out.npy");
+    // Every writer creates missing parents: `--out renders/a/out.npy` works everywhere.
+    let path = dir.path().join("renders").join("a").join("out.npy");
+    write_bytes(&path, b"x").unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), b"x");
+    // A file standing where a folder should be: refused, naming the target and the file.
+    std::fs::write(dir.path().join("taken"), b"file").unwrap();
+    let path = dir.path().join("taken").join("b").join("out.npy");
     let err = write_bytes(&path, b"x").unwrap_err();
-    assert_eq!((err.op, err.path.as_path()), ("create", path.as_path()));
-    assert_eq!(err.source.kind(), std::io::ErrorKind::NotFound);
-    assert!(
-        err.to_string()
-            .starts_with(&format!("cannot create {}: ", path.display())),
-        "{err}"
+    assert_eq!(
+        (err.op, err.path.as_path()),
+        ("create the folders of", path.as_path())
     );
-    assert!(entries(dir.path()).is_empty());
+    assert_eq!(err.source.kind(), std::io::ErrorKind::NotADirectory);
+    let message = err.to_string();
+    assert!(
+        message.starts_with(&format!(
+            "cannot create the folders of {}: ",
+            path.display()
+        )) && message.contains("taken exists and is not a folder"),
+        "{message}"
+    );
+    assert_eq!(entries(dir.path()), ["renders", "taken"]);
 }
 
 #[test]
@@ -159,15 +171,25 @@ fn write_via_path_returns_the_closure_error_and_removes_the_temporary() {
 }
 
 #[test]
-fn write_via_path_into_a_missing_folder_fails_before_calling_the_encoder() {
+fn write_via_path_below_a_file_fails_before_calling_the_encoder() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("missing").join("a.png");
+    std::fs::write(dir.path().join("file"), b"x").unwrap();
+    let path = dir.path().join("file").join("a.png");
     let err = write_via_path(&path, |_| -> Result<(), String> {
         panic!("the encoder must not run without a temporary file")
     })
     .unwrap_err();
     assert!(
-        matches!(&err, AtomicError::File(WriteError { op: "create", path: p, .. }) if *p == path),
+        matches!(&err, AtomicError::File(WriteError { op: "create the folders of", path: p, .. }) if *p == path),
+        "{err}"
+    );
+    // With a file name that is no file: the temporary cannot be created.
+    let err = write_via_path(Path::new("/"), |_| -> Result<(), String> {
+        panic!("the encoder must not run without a temporary file")
+    })
+    .unwrap_err();
+    assert!(
+        matches!(&err, AtomicError::File(WriteError { op: "create", .. })),
         "{err}"
     );
 }
@@ -261,7 +283,8 @@ fn sigterm_child_blocks_mid_write() {
     };
     remove_temporaries_on_signal().unwrap();
     remove_temporaries_on_signal().unwrap();
-    let result = write_dir(&dir.join("frames"), ExistingFolder::Refuse, |folder| {
+    // Into a missing parent, which the handler removes too.
+    let result = write_dir(&dir.join("run/frames"), ExistingFolder::Refuse, |folder| {
         std::fs::write(folder.join("frame_00000.obj"), "v 0 0 0\n").unwrap();
         write_with(&folder.join("frame_00001.obj"), |w| {
             w.write_all(&[1; 100_000])?;
@@ -348,7 +371,7 @@ fn a_folder_output_appears_complete_or_not_at_all() {
     .unwrap();
     assert_eq!(entries(&frames), ["frame_00000.obj"]);
     assert_eq!(entries(dir.path()), ["frames"], "the old folder is gone");
-    // A file where the folder should go, and a missing parent, are errors naming the target.
+    // A file where the folder should go is an error naming the target.
     let file = dir.path().join("file");
     std::fs::write(&file, "x").unwrap();
     let message = write_dir(&file, ExistingFolder::Replace, |_| {
@@ -360,16 +383,18 @@ fn a_folder_output_appears_complete_or_not_at_all() {
         message.contains("file") && message.contains("not a readable folder"),
         "{message}"
     );
-    let missing = dir.path().join("missing/frames");
-    assert!(
-        write_dir(
-            &missing,
-            ExistingFolder::Refuse,
-            |_| Ok::<(), std::io::Error>(())
-        )
-        .is_err()
-    );
+    // Missing parents are created, and removed again when the fill fails.
+    let missing = dir.path().join("missing/deeper/frames");
+    let err = write_dir(&missing, ExistingFolder::Refuse, |_| {
+        Err(std::io::Error::other("no frames"))
+    });
+    assert!(matches!(err, Err(AtomicError::Writer(_))));
     assert_eq!(entries(dir.path()), ["file", "frames"]);
+    write_dir(&missing, ExistingFolder::Refuse, |tmp| {
+        std::fs::write(tmp.join("frame_00000.obj"), "v 0 0 0\n")
+    })
+    .unwrap();
+    assert_eq!(entries(&missing), ["frame_00000.obj"]);
 }
 
 #[test]

@@ -144,11 +144,13 @@ mod tests {
         )
         .unwrap();
         assert_eq!(read.layer_data.channel_data.pixels, img.pixels);
-        // A directory that does not exist: error names the path, no file left behind.
-        let bad = dir.join("missing-dir").join("y.png");
+        // A file where a folder should be: error names the path, no file left behind.
+        let bad = path.join("below").join("y.png");
         let err = write_rgba8_png(&bad, &[0; 24], 3, 2).unwrap_err();
         assert!(err.to_string().contains("y.png"), "{err}");
         assert!(!bad.exists());
+        // A folder that does not exist is created, as by every writer.
+        write_rgba8_png(&dir.join("new-dir").join("z.png"), &[0; 24], 3, 2).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -198,13 +198,17 @@ fn exr_round_trip_is_exact_and_leaves_no_temporary_file() {
 }
 
 #[test]
-fn writing_into_a_missing_directory_fails_without_output() {
+fn writing_below_a_file_fails_without_output_and_missing_folders_are_created() {
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("missing").join("map.exr");
+    std::fs::write(dir.path().join("taken"), b"a file").unwrap();
+    let path = dir.path().join("taken").join("map.exr");
     let err = test_map(4, 2, 1).write_exr(&path).unwrap_err();
     assert!(matches!(err, LightsphereError::Io { .. }), "{err}");
-    assert!(err.to_string().contains("missing"), "{err}");
+    assert!(err.to_string().contains("taken"), "{err}");
     assert!(!path.exists());
+    let nested = dir.path().join("new").join("map.exr");
+    test_map(4, 2, 1).write_exr(&nested).unwrap();
+    assert!(nested.is_file());
 }
 
 #[test]

@@ -107,11 +107,16 @@ fn shape_mismatch_writes_nothing() {
     ));
     assert!(!path.exists());
     assert!(write_npy_f32(&path, &[usize::MAX, 3], &[]).is_err());
-    // A folder that does not exist: an I/O error, no output.
+    // Below a file, where no folder can be created: an I/O error, no output.
+    let blocker = dir.path().join("blocker");
+    std::fs::write(&blocker, b"a file").unwrap();
     assert!(matches!(
-        write_npy_f32(&dir.path().join("no/such/dir/a.npy"), &[1], &[1.0]),
+        write_npy_f32(&blocker.join("below/a.npy"), &[1], &[1.0]),
         Err(MeshIoError::Io { .. })
     ));
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    // Missing folders are created, as by every writer.
+    write_npy_f32(&dir.path().join("new/dir/a.npy"), &[1], &[1.0]).unwrap();
 }
 
 #[test]
