@@ -96,3 +96,13 @@ impl From<atomic_out::WriteError> for Error {
         }
     }
 }
+
+/// A folder output ([`atomic_out::write_dir`]) whose filling returned our own error.
+impl From<atomic_out::AtomicError<Error>> for Error {
+    fn from(e: atomic_out::AtomicError<Error>) -> Self {
+        match e {
+            atomic_out::AtomicError::Writer(e) => e,
+            atomic_out::AtomicError::File(e) => e.into(),
+        }
+    }
+}

@@ -738,3 +738,93 @@ fn corrupt_gltf_files_are_errors_not_panics() {
         Err(MeshIoError::EmptyMesh { .. })
     ));
 }
+
+// ---------------------------------------------------------------- streamed .glb animations
+
+/// The streamed writer asks for frame 0 once and every other frame twice (bounds, then bytes);
+/// a clip longer than the format's weights can sensibly hold, a source that fails, and a
+/// source that changes between the passes are errors that leave no file.
+#[test]
+fn streamed_glb_animation_refuses_long_failing_and_changing_sources() {
+    let dir = tempfile::tempdir().unwrap();
+    let triangles = [[0u32, 1, 2]];
+    let clip = |frames| meshio::GlbClip {
+        triangles: &triangles,
+        uvs: None,
+        frame_rate: 30.0,
+        frames,
+        vertices: 3,
+    };
+    let tri = |f: usize| [Vec3::ZERO, Vec3::X, Vec3::Y].map(|v| v + Vec3::Z * f as f32);
+    let path = dir.path().join("a.glb");
+    let mut calls = Vec::new();
+    meshio::write_glb_animation_with(&path, &clip(4), |f, p: &mut [Vec3]| {
+        calls.push(f);
+        p.copy_from_slice(&tri(f));
+        Ok::<(), MeshIoError>(())
+    })
+    .unwrap();
+    assert_eq!(calls, [0, 1, 2, 3, 1, 2, 3]);
+
+    let long = dir.path().join("long.glb");
+    let err = meshio::write_glb_animation_with(
+        &long,
+        &clip(meshio::MAX_GLB_ANIMATION_FRAMES + 1),
+        |_, _: &mut [Vec3]| -> Result<(), MeshIoError> { panic!("refused before any frame") },
+    )
+    .unwrap_err();
+    let message = err.to_string();
+    assert!(
+        message.contains("4097 frames") && message.contains("MAX_GLB_ANIMATION_FRAMES"),
+        "{message}"
+    );
+
+    #[derive(Debug)]
+    enum SourceError {
+        Decoder(usize),
+        Mesh(MeshIoError),
+    }
+    impl From<MeshIoError> for SourceError {
+        fn from(e: MeshIoError) -> Self {
+            Self::Mesh(e)
+        }
+    }
+    let failing = dir.path().join("failing.glb");
+    let mut second_pass = false;
+    let err = meshio::write_glb_animation_with(&failing, &clip(4), |f, p: &mut [Vec3]| {
+        second_pass |= f == 3;
+        if second_pass && f == 2 {
+            return Err(SourceError::Decoder(f));
+        }
+        p.copy_from_slice(&tri(f));
+        Ok(())
+    })
+    .unwrap_err();
+    assert!(matches!(err, SourceError::Decoder(2)), "{err:?}");
+    // The writer's own errors come back through the caller's `From<MeshIoError>`.
+    let err = meshio::write_glb_animation_with(&failing, &clip(0), |_, _: &mut [Vec3]| Ok(()))
+        .unwrap_err();
+    let SourceError::Mesh(mesh) = err else {
+        panic!("{err:?}");
+    };
+    assert!(mesh.to_string().contains("has 0 frames"), "{mesh}");
+
+    let changing = dir.path().join("changing.glb");
+    let mut call = 0;
+    let err = meshio::write_glb_animation_with(&changing, &clip(3), |f, p: &mut [Vec3]| {
+        call += 1;
+        p.copy_from_slice(&tri(f + usize::from(call > 3)));
+        Ok::<(), MeshIoError>(())
+    })
+    .unwrap_err();
+    let message = err.to_string();
+    assert!(
+        message.contains("frame 1 POSITION") && message.contains("deterministic"),
+        "{message}"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left, ["a.glb"]);
+}

@@ -284,3 +284,46 @@ fn fifos_are_refused_by_name_without_hanging() {
         &["buffer.bin", "FIFO"],
     );
 }
+
+/// A clip written through the streamed `.glb` writer holds a few frames' worth of vertex arrays
+/// (base, current, normals, deltas: O(V)), not F frames: the decoder of `anim decompress`
+/// feeds it frame by frame. 128 frames × 50,000 vertices are 77 MB of positions alone; the
+/// writer stays under ten frames' worth (6 MB).
+#[test]
+fn streamed_glb_animation_holds_two_frames_not_the_clip() {
+    let (frames, vertices) = (128, 50_000);
+    let triangles: Vec<[u32; 3]> = (0..vertices as u32 - 2)
+        .map(|i| [i, i + 1, i + 2])
+        .collect();
+    let clip = meshio::GlbClip {
+        triangles: &triangles,
+        uvs: None,
+        frame_rate: 30.0,
+        frames,
+        vertices,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("long.glb");
+    let frame = |f: usize, p: &mut [glam::Vec3]| {
+        for (i, v) in p.iter_mut().enumerate() {
+            let x = i as f32 * 1e-3;
+            *v = glam::Vec3::new(x, (x * 7.0 + f as f32 * 0.1).sin(), (x * 3.0).cos());
+        }
+        Ok::<(), MeshIoError>(())
+    };
+    let (written, peak) = peak_of(|| meshio::write_glb_animation_with(&path, &clip, frame));
+    written.unwrap();
+    let (one_frame, all_frames) = (vertices * 12, frames * vertices * 12);
+    assert!(
+        peak < 10 * one_frame,
+        "peak {peak} bytes for a clip of {all_frames} bytes of positions"
+    );
+    // And the file reads back: frame 63 as written.
+    let (clip, _) = load_animation(&path, &AnimationOptions::default()).unwrap();
+    assert_eq!(clip.frames.len(), frames);
+    let mut expected = vec![glam::Vec3::ZERO; vertices];
+    frame(63, &mut expected).unwrap();
+    for (a, b) in clip.frames[63].iter().zip(&expected) {
+        assert!((*a - *b).abs().max_element() < 1e-5, "{a} vs {b}");
+    }
+}

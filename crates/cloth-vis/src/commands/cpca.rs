@@ -350,6 +350,19 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
     let kind = out_kind(&request.out, request.force)?;
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
     let (data, _) = read_cpca(&request.input)?;
+    if kind == OutKind::Glb && data.frames() > meshio::MAX_GLB_ANIMATION_FRAMES {
+        return Err(invalid(
+            &request.out,
+            format!(
+                "{} has {} frames; a .glb morph-target animation holds at most {} \
+                 (meshio::MAX_GLB_ANIMATION_FRAMES: its weights grow as F²): write .npy or an \
+                 OBJ folder instead",
+                request.input.display(),
+                data.frames(),
+                meshio::MAX_GLB_ANIMATION_FRAMES
+            ),
+        ));
+    }
     if kind == OutKind::Glb && data.triangles().is_empty() {
         return Err(invalid(
             &request.input,
@@ -358,40 +371,57 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
                 .to_owned(),
         ));
     }
-    let start = Instant::now();
+    // Streamed into every kind of output: one frame decoded, written, dropped (peak memory
+    // O(V), not 2·F·V). A .glb asks for each frame twice (its JSON, written first, holds the
+    // morph targets' bounds).
     let decoder = Decoder::new(&data);
-    let decode_seconds = if kind == OutKind::Npy {
-        // Streamed: one frame decoded, written, dropped (peak memory O(V), not 2·F·V).
-        let mut scratch = decoder.scratch();
-        let mut failure = None;
-        let mut decoding = std::time::Duration::ZERO;
-        let frames = (0..decoder.frames()).map(|f| {
-            let mut out = vec![Vec3::ZERO; decoder.vertices()];
-            let t = Instant::now();
-            if let Err(e) = decoder.frame_into(f, &mut out, &mut scratch) {
-                failure.get_or_insert(e);
-            }
-            decoding += t.elapsed();
-            out
-        });
-        meshio::write_npy_frames(&request.out, decoder.frames(), decoder.vertices(), frames)?;
-        if let Some(e) = failure {
-            let _ = std::fs::remove_file(&request.out);
-            return Err(anim_error(&request.input, e));
-        }
-        decoding.as_secs_f64()
-    } else {
-        let frames = decoder.decode_all();
-        let seconds = start.elapsed().as_secs_f64();
-        write_frames(
-            &request.out,
-            kind,
-            frames,
-            data.triangles(),
-            data.frame_rate(),
-        )?;
-        seconds
+    let mut scratch = decoder.scratch();
+    let mut decoding = std::time::Duration::ZERO;
+    let mut decode = |f: usize, out: &mut [Vec3]| -> Result<(), Error> {
+        let t = Instant::now();
+        let result = decoder.frame_into(f, out, &mut scratch);
+        decoding += t.elapsed();
+        result.map_err(|e| anim_error(&request.input, e))
     };
+    let (frames, vertices) = (decoder.frames(), decoder.vertices());
+    match kind {
+        OutKind::Npy => {
+            let mut failure = None;
+            let stream = (0..frames).map(|f| {
+                let mut out = vec![Vec3::ZERO; vertices];
+                if let Err(e) = decode(f, &mut out) {
+                    failure.get_or_insert(e);
+                }
+                out
+            });
+            meshio::write_npy_frames(&request.out, frames, vertices, stream)?;
+            if let Some(e) = failure {
+                let _ = std::fs::remove_file(&request.out);
+                return Err(e);
+            }
+        }
+        OutKind::Glb => {
+            let clip = meshio::GlbClip {
+                triangles: data.triangles(),
+                uvs: None,
+                frame_rate: glb_frame_rate(data.frame_rate()),
+                frames,
+                vertices,
+            };
+            meshio::write_glb_animation_with(&request.out, &clip, &mut decode)?;
+        }
+        OutKind::ObjFolder(existing) => super::jumpmap::write_obj_frames(
+            &request.out,
+            existing,
+            (0..frames).map(|f| {
+                let mut out = vec![Vec3::ZERO; vertices];
+                decode(f, &mut out).map(|()| out)
+            }),
+            data.triangles(),
+            "cloth-vis anim decompress",
+        )?,
+    }
+    let decode_seconds = decoding.as_secs_f64();
     Ok(DecompressSummary {
         vertices: data.vertices(),
         frames: data.frames(),
@@ -547,39 +577,6 @@ pub fn error_chart(distortion: &Distortion, cpca: &Path) -> String {
                 .collect(),
         }],
     )
-}
-
-/// Writes decoded frames to `out` as `kind`.
-fn write_frames(
-    out: &Path,
-    kind: OutKind,
-    frames: Vec<Vec<Vec3>>,
-    triangles: &[[u32; 3]],
-    frame_rate: f32,
-) -> Result<(), Error> {
-    match kind {
-        OutKind::Npy => {
-            let vertices = frames.first().map_or(0, Vec::len);
-            meshio::write_npy_frames(out, frames.len(), vertices, &frames)?;
-        }
-        OutKind::Glb => {
-            let animation = meshio::Animation {
-                triangles: triangles.to_vec(),
-                frames,
-                frame_rate: glb_frame_rate(frame_rate),
-                uvs: None,
-            };
-            meshio::write_glb_animation(out, &animation)?;
-        }
-        OutKind::ObjFolder(existing) => super::jumpmap::write_obj_frames(
-            out,
-            existing,
-            &frames,
-            triangles,
-            "cloth-vis anim decompress",
-        )?,
-    }
-    Ok(())
 }
 
 /// Frame rate written to a `.glb` when the file's is not a positive number (the loaders'

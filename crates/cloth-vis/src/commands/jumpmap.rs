@@ -161,6 +161,12 @@ pub fn run_jumpmap(
             ));
         }
     };
+    // The heat-map folder is a folder output too: refused before any work when it holds files.
+    let maps_existing = request
+        .maps
+        .as_deref()
+        .map(|dir| super::folder_output(dir, request.force))
+        .transpose()?;
     if request.frames == 0 {
         return Err(invalid(out, "--frames must be at least 1".to_owned()));
     }
@@ -363,13 +369,13 @@ pub fn run_jumpmap(
         OutKind::ObjFolder(existing) => write_obj_frames(
             out,
             existing,
-            &frames,
+            frames.iter().map(Ok),
             &clip.triangles,
             "cloth-vis anim jumpmap, generated",
         )?,
     }
-    if let Some(dir) = &request.maps {
-        write_maps(dir, &map)?;
+    if let (Some(dir), Some(existing)) = (&request.maps, maps_existing) {
+        write_maps(dir, existing, &map)?;
     }
     Ok(JumpMapSummary {
         clip_frames: map.n_frames(),
@@ -383,44 +389,60 @@ pub fn run_jumpmap(
 /// `# {what}, frame N`: built in a temporary folder beside it and renamed into place when every
 /// frame is written (`atomic_out::write_dir`), so an interrupted run leaves no shorter clip
 /// that looks complete; `existing` says what happens to a folder that holds files.
-pub(crate) fn write_obj_frames(
+/// Frames come from an iterator (a decoder streams them: one frame in memory at a time).
+pub(crate) fn write_obj_frames<P: AsRef<[Vec3]>>(
     dir: &Path,
     existing: atomic_out::ExistingFolder,
-    frames: &[Vec<Vec3>],
+    frames: impl IntoIterator<Item = Result<P, Error>>,
     triangles: &[[u32; 3]],
     what: &str,
 ) -> Result<(), Error> {
     atomic_out::write_dir(dir, existing, |tmp| {
-        for (f, positions) in frames.iter().enumerate() {
-            let path = tmp.join(format!("frame_{f:05}.obj"));
-            let file = std::fs::File::create(&path)?;
-            let mut w = std::io::BufWriter::new(file);
-            writeln!(w, "# {what}, frame {f}")?;
-            for p in positions {
-                writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
-            }
-            for t in triangles {
-                writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
-            }
-            w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        for (f, positions) in frames.into_iter().enumerate() {
+            let name = format!("frame_{f:05}.obj");
+            write_obj_frame(&tmp.join(&name), f, positions?.as_ref(), triangles, what).map_err(
+                |e| Error::Io {
+                    path: dir.join(&name),
+                    reason: e.to_string(),
+                },
+            )?;
         }
-        Ok::<(), std::io::Error>(())
-    })
-    .map_err(|e| Error::Io {
-        path: dir.to_owned(),
-        reason: e.to_string(),
-    })
+        Ok(())
+    })?;
+    Ok(())
+}
+
+fn write_obj_frame(
+    path: &Path,
+    f: usize,
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    what: &str,
+) -> std::io::Result<()> {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(w, "# {what}, frame {f}")?;
+    for p in positions {
+        writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    for t in triangles {
+        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+    }
+    w.into_inner().map_err(|e| e.into_error())?.sync_all()
 }
 
 /// The five matrices of the analysis as heat maps, one pixel per entry (scaled up to at least
 /// 256 pixels a side): distances linearly from 0 to their maximum, probabilities on a log
 /// scale over six decades below the matrix's maximum (as the thesis's Fig. 3.3 shows them,
 /// black = 0).
-fn write_maps(dir: &Path, map: &JumpMap) -> Result<(), Error> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-        path: dir.to_owned(),
-        reason: e.to_string(),
-    })?;
+fn write_maps(
+    dir: &Path,
+    existing: atomic_out::ExistingFolder,
+    map: &JumpMap,
+) -> Result<(), Error> {
+    atomic_out::write_dir(dir, existing, |tmp| write_map_files(tmp, map)).map_err(Error::from)
+}
+
+fn write_map_files(dir: &Path, map: &JumpMap) -> Result<(), Error> {
     let maps: [(&str, &anim_pca::SquareMatrix, bool); 5] = [
         ("D.png", map.distances(), false),
         ("D_velocity.png", map.velocity_distances(), false),

@@ -17,6 +17,7 @@ mod pose;
 mod rig;
 mod sampler;
 mod source;
+mod stream;
 mod write;
 
 use std::path::Path;
@@ -28,6 +29,7 @@ use rig::Rig;
 use sampler::Clip;
 use source::GltfSource;
 pub use source::{GLTF_DECODE_FLOOR, GLTF_DECODE_PER_INPUT_BYTE};
+pub use stream::{GlbClip, MAX_GLB_ANIMATION_FRAMES, write_glb_animation_with};
 pub use write::{GlbMesh, NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation};
 
 use crate::validate::{RawMesh, finish_animation, finish_mesh};

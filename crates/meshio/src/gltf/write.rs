@@ -32,10 +32,11 @@
 use std::io::Write as _;
 use std::path::Path;
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use serde_json::{Value, json};
 
-use crate::{Animation, MeshIoError, NormalWeighting, compute_normals};
+use super::stream::{GlbClip, write_glb_animation_with};
+use crate::{Animation, MeshIoError};
 
 /// `"glTF"` as a little-endian u32.
 const GLB_MAGIC: u32 = 0x4654_6C67;
@@ -46,13 +47,13 @@ const CHUNK_JSON: u32 = 0x4E4F_534A;
 /// Chunk type `BIN\0`.
 const CHUNK_BIN: u32 = 0x004E_4942;
 /// `bufferView.target` for vertex attributes.
-const TARGET_ARRAY_BUFFER: u32 = 34_962;
+pub(super) const TARGET_ARRAY_BUFFER: u32 = 34_962;
 /// `bufferView.target` for indices.
-const TARGET_ELEMENT_ARRAY_BUFFER: u32 = 34_963;
+pub(super) const TARGET_ELEMENT_ARRAY_BUFFER: u32 = 34_963;
 /// `accessor.componentType` FLOAT.
-const COMPONENT_FLOAT: u32 = 5126;
+pub(super) const COMPONENT_FLOAT: u32 = 5126;
 /// `accessor.componentType` UNSIGNED_INT.
-const COMPONENT_UNSIGNED_INT: u32 = 5125;
+pub(super) const COMPONENT_UNSIGNED_INT: u32 = 5125;
 /// Largest accepted deviation of a normal's length from 1. f32 normalisation leaves ~1e-7;
 /// viewers and the Khronos validator expect unit normals.
 pub const NORMAL_UNIT_TOLERANCE: f32 = 1e-4;
@@ -192,14 +193,17 @@ pub fn write_glb(path: &Path, mesh: &GlbMesh<'_>) -> Result<(), MeshIoError> {
 /// Writes `animation` as a glTF 2.0 binary file with one morph target per frame after the
 /// first and a `STEP` weights clip at `animation.frame_rate` (module docs), atomically.
 ///
-/// Normals are computed per frame ([`compute_normals`], angle-weighted) and written as
+/// Normals are computed per frame ([`crate::compute_normals`], angle-weighted) and written as
 /// `NORMAL` and morph-target normal deltas; a vertex no face uses gets the normal +Y so that
 /// every normal is unit length. UVs, when present, are written as `TEXCOORD_0`. A single-frame
 /// animation is written as a static mesh (no clip).
 ///
+/// Frames go through [`write_glb_animation_with`], the streamed writer, which
+/// `anim decompress` feeds from the decoder one frame at a time.
+///
 /// # Errors
-/// As [`write_glb`], plus: no frame, a frame with a different vertex count than frame 0, a
-/// non-finite or non-positive frame rate.
+/// As [`write_glb`], plus: no frame, more than [`super::MAX_GLB_ANIMATION_FRAMES`], a frame
+/// with a different vertex count than frame 0, a non-finite or non-positive frame rate.
 pub fn write_glb_animation(path: &Path, animation: &Animation) -> Result<(), MeshIoError> {
     let Some(first) = animation.frames.first() else {
         return Err(invalid(
@@ -208,80 +212,23 @@ pub fn write_glb_animation(path: &Path, animation: &Animation) -> Result<(), Mes
             "has no frame; an animation needs at least one".into(),
         ));
     };
-    let rate = animation.frame_rate;
-    if !(rate.is_finite() && rate > 0.0) {
-        return Err(invalid(
-            path,
-            "animation frame_rate".into(),
-            format!("{rate} must be finite and > 0"),
-        ));
-    }
     let n = first.len();
-    check_topology(path, n, &animation.triangles)?;
-    for (f, frame) in animation.frames.iter().enumerate() {
-        check_vec3(path, &format!("frame {f} POSITION"), frame, n)?;
-    }
-    if let Some(uvs) = &animation.uvs {
-        check_len(path, "TEXCOORD_0", uvs.len(), n)?;
-        check_finite(path, "TEXCOORD_0", uvs.iter().flat_map(|uv| uv.to_array()))?;
-    }
-
-    let normals_of = |frame: &[Vec3]| -> Vec<Vec3> {
-        compute_normals(frame, &animation.triangles, NormalWeighting::Angle)
-            .into_iter()
-            .map(|nrm| if nrm == Vec3::ZERO { Vec3::Y } else { nrm })
-            .collect()
+    let clip = GlbClip {
+        triangles: &animation.triangles,
+        uvs: animation.uvs.as_deref(),
+        frame_rate: animation.frame_rate,
+        frames: animation.frames.len(),
+        vertices: n,
     };
-    let mut b = Builder::default();
-    let base_normals = normals_of(first);
-    let mut attributes = serde_json::Map::new();
-    attributes.insert("POSITION".into(), b.vec3(first, true).into());
-    attributes.insert("NORMAL".into(), b.vec3(&base_normals, false).into());
-    if let Some(uvs) = &animation.uvs {
-        attributes.insert("TEXCOORD_0".into(), b.vec2(uvs).into());
-    }
-    let indices = b.indices(&animation.triangles);
-    let targets: Vec<Value> = animation.frames[1..]
-        .iter()
-        .map(|frame| {
-            let dp: Vec<Vec3> = frame.iter().zip(first).map(|(p, p0)| *p - *p0).collect();
-            let dn: Vec<Vec3> = normals_of(frame)
-                .iter()
-                .zip(&base_normals)
-                .map(|(nf, n0)| *nf - *n0)
-                .collect();
-            json!({ "POSITION": b.vec3(&dp, true), "NORMAL": b.vec3(&dn, false) })
-        })
-        .collect();
-    let target_count = targets.len();
-    let mut primitive = json!({ "attributes": attributes, "indices": indices, "mode": 4 });
-    let mut mesh = json!({ "name": "animation" });
-    let mut animations = None;
-    if target_count > 0 {
-        primitive["targets"] = Value::Array(targets);
-        mesh["weights"] = json!(vec![0.0; target_count]);
-        // The same expression as the loader's sampling times, so that STEP look-ups at
-        // f / frame_rate land exactly on keyframe f.
-        let times: Vec<f32> = (0..animation.frames.len())
-            .map(|f| (f as f64 / f64::from(rate)) as f32)
-            .collect();
-        let mut weights = vec![0.0f32; animation.frames.len() * target_count];
-        for f in 1..animation.frames.len() {
-            weights[f * target_count + (f - 1)] = 1.0;
-        }
-        let input = b.animation_input(&times);
-        let output = b.scalars(&weights, 0);
-        animations = Some(json!([{
-            "name": "frames",
-            "samplers": [{ "input": input, "output": output, "interpolation": "STEP" }],
-            "channels": [{ "sampler": 0, "target": { "node": 0, "path": "weights" } }],
-        }]));
-    }
-    mesh["primitives"] = json!([primitive]);
-    b.finish(path, json!([mesh]), animations)
+    write_glb_animation_with(path, &clip, |f, out: &mut [Vec3]| {
+        let frame = &animation.frames[f];
+        check_vec3(path, &format!("frame {f} POSITION"), frame, n)?;
+        out.copy_from_slice(frame);
+        Ok(())
+    })
 }
 
-fn invalid(path: &Path, element: String, problem: String) -> MeshIoError {
+pub(super) fn invalid(path: &Path, element: String, problem: String) -> MeshIoError {
     MeshIoError::InvalidWriteInput {
         path: path.to_path_buf(),
         element,
@@ -289,7 +236,12 @@ fn invalid(path: &Path, element: String, problem: String) -> MeshIoError {
     }
 }
 
-fn check_len(path: &Path, element: &str, len: usize, n: usize) -> Result<(), MeshIoError> {
+pub(super) fn check_len(
+    path: &Path,
+    element: &str,
+    len: usize,
+    n: usize,
+) -> Result<(), MeshIoError> {
     if len == n {
         return Ok(());
     }
@@ -300,7 +252,7 @@ fn check_len(path: &Path, element: &str, len: usize, n: usize) -> Result<(), Mes
     ))
 }
 
-fn check_finite(
+pub(super) fn check_finite(
     path: &Path,
     element: &str,
     values: impl Iterator<Item = f32>,
@@ -315,7 +267,12 @@ fn check_finite(
     }
 }
 
-fn check_vec3(path: &Path, element: &str, values: &[Vec3], n: usize) -> Result<(), MeshIoError> {
+pub(super) fn check_vec3(
+    path: &Path,
+    element: &str,
+    values: &[Vec3],
+    n: usize,
+) -> Result<(), MeshIoError> {
     check_len(path, element, values.len(), n)?;
     match values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
         None => Ok(()),
@@ -346,7 +303,11 @@ fn check_unit(path: &Path, element: &str, normals: &[Vec3]) -> Result<(), MeshIo
     }
 }
 
-fn check_topology(path: &Path, n: usize, triangles: &[[u32; 3]]) -> Result<(), MeshIoError> {
+pub(super) fn check_topology(
+    path: &Path,
+    n: usize,
+    triangles: &[[u32; 3]],
+) -> Result<(), MeshIoError> {
     if n == 0 || triangles.is_empty() {
         return Err(invalid(
             path,
@@ -444,19 +405,6 @@ impl Builder {
         self.accessor(acc)
     }
 
-    fn vec2(&mut self, data: &[Vec2]) -> usize {
-        let view = self.view(
-            data.iter().flat_map(|v| v.to_array()).map(f32::to_le_bytes),
-            TARGET_ARRAY_BUFFER,
-        );
-        self.accessor(json!({
-            "bufferView": view,
-            "componentType": COMPONENT_FLOAT,
-            "count": data.len(),
-            "type": "VEC2",
-        }))
-    }
-
     fn scalars(&mut self, data: &[f32], target: u32) -> usize {
         let view = self.view(data.iter().map(|v| v.to_le_bytes()), target);
         self.accessor(json!({
@@ -464,21 +412,6 @@ impl Builder {
             "componentType": COMPONENT_FLOAT,
             "count": data.len(),
             "type": "SCALAR",
-        }))
-    }
-
-    /// Keyframe times: `min`/`max` are required for animation sampler inputs.
-    fn animation_input(&mut self, times: &[f32]) -> usize {
-        let view = self.view(times.iter().map(|v| v.to_le_bytes()), 0);
-        let lo = times.iter().copied().fold(f32::INFINITY, f32::min);
-        let hi = times.iter().copied().fold(f32::NEG_INFINITY, f32::max);
-        self.accessor(json!({
-            "bufferView": view,
-            "componentType": COMPONENT_FLOAT,
-            "count": times.len(),
-            "type": "SCALAR",
-            "min": [f64::from(lo)],
-            "max": [f64::from(hi)],
         }))
     }
 
@@ -504,47 +437,78 @@ impl Builder {
         animations: Option<Value>,
     ) -> Result<(), MeshIoError> {
         self.bin.resize(self.bin.len().next_multiple_of(4), 0);
-        let mut root = json!({
-            "asset": { "version": "2.0", "generator": GENERATOR },
-            "scene": 0,
-            "scenes": [{ "nodes": [0] }],
-            "nodes": [{ "mesh": 0 }],
-            "meshes": meshes,
-            "accessors": self.accessors,
-            "bufferViews": self.views,
-            "buffers": [{ "byteLength": self.bin.len() }],
-        });
-        if let Some(animations) = animations {
-            root["animations"] = animations;
-        }
-        let mut text = serde_json::to_vec(&root).map_err(|e| {
-            invalid(
-                path,
-                "glTF JSON".into(),
-                format!("cannot be serialized: {e}"),
-            )
-        })?;
-        text.resize(text.len().next_multiple_of(4), b' ');
-        let too_large = || {
-            invalid(
-                path,
-                "GLB container".into(),
-                "would exceed the format's 4 GiB limit; write fewer frames or vertices".into(),
-            )
-        };
-        let total = 12 + 8 + text.len() + 8 + self.bin.len();
-        let total = u32::try_from(total).map_err(|_| too_large())?;
-        let json_len = u32::try_from(text.len()).map_err(|_| too_large())?;
-        let bin_len = u32::try_from(self.bin.len()).map_err(|_| too_large())?;
-        atomic_out::write_with(path, |w| {
-            for word in [GLB_MAGIC, GLB_VERSION, total, json_len, CHUNK_JSON] {
-                w.write_all(&word.to_le_bytes())?;
-            }
-            w.write_all(&text)?;
-            w.write_all(&bin_len.to_le_bytes())?;
-            w.write_all(&CHUNK_BIN.to_le_bytes())?;
-            w.write_all(&self.bin)
-        })?;
-        Ok(())
+        let root = glb_root(
+            meshes,
+            self.accessors,
+            self.views,
+            self.bin.len(),
+            animations,
+        );
+        write_container(path, &root, self.bin.len(), |w| w.write_all(&self.bin))
     }
+}
+
+/// The glTF document of one mesh on node 0 of scene 0, over one buffer of `bin_len` bytes.
+pub(super) fn glb_root(
+    meshes: Value,
+    accessors: Vec<Value>,
+    views: Vec<Value>,
+    bin_len: usize,
+    animations: Option<Value>,
+) -> Value {
+    let mut root = json!({
+        "asset": { "version": "2.0", "generator": GENERATOR },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "mesh": 0 }],
+        "meshes": meshes,
+        "accessors": accessors,
+        "bufferViews": views,
+        "buffers": [{ "byteLength": bin_len }],
+    });
+    if let Some(animations) = animations {
+        root["animations"] = animations;
+    }
+    root
+}
+
+/// Writes the GLB container atomically: header, the JSON chunk (`root`, padded with spaces)
+/// and the BIN chunk, whose `bin_len` bytes (a multiple of 4) `write_bin` writes.
+pub(super) fn write_container(
+    path: &Path,
+    root: &Value,
+    bin_len: usize,
+    write_bin: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> Result<(), MeshIoError> {
+    debug_assert_eq!(bin_len % 4, 0);
+    let text = serde_json::to_vec(root).map_err(|e| {
+        invalid(
+            path,
+            "glTF JSON".into(),
+            format!("cannot be serialized: {e}"),
+        )
+    })?;
+    let padding = text.len().next_multiple_of(4) - text.len();
+    let too_large = || {
+        invalid(
+            path,
+            "GLB container".into(),
+            "would exceed the format's 4 GiB limit; write fewer frames or vertices".into(),
+        )
+    };
+    let total = 12 + 8 + text.len() + padding + 8 + bin_len;
+    let total = u32::try_from(total).map_err(|_| too_large())?;
+    let json_len = u32::try_from(text.len() + padding).map_err(|_| too_large())?;
+    let bin_len = u32::try_from(bin_len).map_err(|_| too_large())?;
+    atomic_out::write_with(path, |w| {
+        for word in [GLB_MAGIC, GLB_VERSION, total, json_len, CHUNK_JSON] {
+            w.write_all(&word.to_le_bytes())?;
+        }
+        w.write_all(&text)?;
+        w.write_all(&b"   "[..padding])?;
+        w.write_all(&bin_len.to_le_bytes())?;
+        w.write_all(&CHUNK_BIN.to_le_bytes())?;
+        write_bin(w)
+    })?;
+    Ok(())
 }

@@ -481,18 +481,7 @@ fn stats_draws_the_error_per_frame_and_the_clusters() {
     let dir = tempfile::tempdir().unwrap();
     let (input, frames) = write_clip(dir.path());
     let cpca = dir.path().join("c.cpca");
-    run_compress(&CompressRequest {
-        input: input.clone(),
-        params: anim_pca::compress::CpcaParams {
-            clusters: 2,
-            components: 2,
-            ..Default::default()
-        },
-        target: None,
-        k_max: DEFAULT_K_MAX,
-        out: cpca.clone(),
-    })
-    .unwrap();
+    compress_into(&input.clone(), &cpca, 2, 2);
     let svg = dir.path().join("df.svg");
     let out = cli(&[
         "anim",
@@ -591,4 +580,97 @@ fn stats_draws_the_error_per_frame_and_the_clusters() {
         labels[0], labels[40],
         "the bars should fall in different clusters"
     );
+}
+
+/// `anim decompress` streams frames into a `.glb` (issue #12: it decoded the whole clip, then
+/// copied it again, before writing): the file reads back as the decoder's frames, up to the
+/// f32 rounding of the morph-target layout (frame 0 + delta).
+#[test]
+fn glb_output_reads_back_as_the_decoded_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    // The two-bar clip as a ribbon: consecutive vertices of each bar form triangles.
+    let triangles: Vec<[u32; 3]> = (0..VERTICES as u32 - 2)
+        .filter(|i| i % 32 < 30)
+        .map(|i| [i, i + 1, i + 2])
+        .collect();
+    let input = dir.path().join("clip.glb");
+    let animation = meshio::Animation {
+        triangles: triangles.clone(),
+        frames: clip(),
+        frame_rate: 30.0,
+        uvs: None,
+    };
+    meshio::write_glb_animation(&input, &animation).unwrap();
+    let cpca = dir.path().join("clip.cpca");
+    compress_into(&input, &cpca, 2, 6);
+    let glb = dir.path().join("out/decoded.glb");
+    let run = cli(&["anim", "decompress", text(&cpca), "--out", text(&glb)]);
+    assert_ok(&run);
+    let (back, _) = meshio::load_animation(&glb, &meshio::AnimationOptions::default()).unwrap();
+    let expected =
+        Decoder::new(&Compressed::from_bytes(&std::fs::read(&cpca).unwrap()).unwrap()).decode_all();
+    assert_eq!(back.frames.len(), expected.len());
+    // The same triangles, each possibly starting at another corner (same winding).
+    let canonical = |t: &[u32; 3]| {
+        let k = (0..3).min_by_key(|&k| t[k]).unwrap_or(0);
+        [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+    };
+    let back_triangles: Vec<[u32; 3]> = back.triangles.iter().map(canonical).collect();
+    assert_eq!(back_triangles, triangles);
+    for (f, (a, b)) in back.frames.iter().zip(&expected).enumerate() {
+        for (p, q) in a.iter().zip(b) {
+            // |p| ≤ 12: two roundings of f32 (delta, then sum) stay below 4 ulp of 16.
+            assert!(
+                (*p - *q).abs().max_element() <= 4e-6,
+                "frame {f}: {p} vs {q}"
+            );
+        }
+    }
+}
+
+/// A `.glb` morph animation's weights grow as F²: a clip longer than
+/// `meshio::MAX_GLB_ANIMATION_FRAMES` is refused before decoding, naming the count, the limit
+/// and the outputs that take it; nothing is written.
+#[test]
+fn a_clip_too_long_for_glb_is_refused_before_decoding() {
+    let dir = tempfile::tempdir().unwrap();
+    let frames = meshio::MAX_GLB_ANIMATION_FRAMES + 1;
+    let long: Vec<f32> = (0..frames)
+        .flat_map(|f| {
+            let t = f as f32 * 0.01;
+            [0.0, 0.0, t, 1.0, t.sin(), 0.0, 0.0, 1.0, t.cos()]
+        })
+        .collect();
+    let input = dir.path().join("long.npy");
+    meshio::write_npy_f32(&input, &[frames, 3, 3], &long).unwrap();
+    let cpca = dir.path().join("long.cpca");
+    compress_into(&input, &cpca, 1, 2);
+    let glb = dir.path().join("long.glb");
+    let run = cli(&["anim", "decompress", text(&cpca), "--out", text(&glb)]);
+    assert_fails_naming(
+        &run,
+        &[
+            text(&glb),
+            "4097 frames",
+            "MAX_GLB_ANIMATION_FRAMES",
+            ".npy",
+        ],
+    );
+    assert!(!glb.exists());
+}
+
+/// `anim compress INPUT --clusters K --components C --out CPCA`, through the library.
+fn compress_into(input: &Path, cpca: &Path, clusters: usize, components: usize) {
+    run_compress(&CompressRequest {
+        input: input.to_owned(),
+        params: anim_pca::compress::CpcaParams {
+            clusters,
+            components,
+            ..Default::default()
+        },
+        target: None,
+        k_max: DEFAULT_K_MAX,
+        out: cpca.to_owned(),
+    })
+    .unwrap();
 }
