@@ -88,10 +88,11 @@ pub enum LightsphereError {
         actual: usize,
     },
 
-    /// A texel that is negative, NaN or infinite.
+    /// A texel that is negative, NaN, infinite or above [`crate::MAX_RADIANCE`].
     #[error(
         "{}: texel (row {row}, col {col}) channel {channel} has value {value}; radiance must be \
-         finite and >= 0, so clamp or repair the map before loading it",
+         finite, >= 0 and <= 1e15 (MAX_RADIANCE: larger values overflow the lighting sums), so \
+         clamp, rescale or repair the map before loading it",
         origin_name(.path.as_deref())
     )]
     InvalidTexel {

@@ -50,8 +50,8 @@ mod sphere;
 pub use environment::MAX_PREFILTER_SIGMA_DEG;
 pub use environment::{
     CellMean, CellMeanParams, CellNormalization, Environment, HDR_TEXELS_FLOOR,
-    HDR_TEXELS_PER_BYTE, MAX_ENV_DIMENSION, MAX_ENV_TEXELS, PrefilterParams, RadianceMethod,
-    matched_sigma_deg,
+    HDR_TEXELS_PER_BYTE, MAX_ENV_DIMENSION, MAX_ENV_TEXELS, MAX_RADIANCE, PrefilterParams,
+    RadianceMethod, matched_sigma_deg,
 };
 pub use error::LightsphereError;
 pub use sphere::{Lightsphere, MAX_LEVEL, direction_count};

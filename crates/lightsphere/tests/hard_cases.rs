@@ -166,6 +166,38 @@ fn nan_infinite_and_negative_texels_are_rejected() {
     }
 }
 
+/// Issue #12: an `.hdr` whose RGBE exponent is 255 (radiance ~6.6·10³⁵, finite) lit the
+/// cloth into f32 overflow and rendered black with exit 0. Above `MAX_RADIANCE` is refused
+/// when the map loads, naming the file, texel and value; `MAX_RADIANCE` itself loads.
+#[test]
+fn huge_but_finite_radiance_is_refused_when_the_map_loads() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("blinding.hdr");
+    write_flat_hdr(&path, 2, 1, &[[128, 128, 128, 129], [255, 255, 255, 255]]);
+    let err = Environment::load(&path).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            LightsphereError::InvalidTexel {
+                row: 0,
+                col: 1,
+                channel: 0,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    let message = err.to_string();
+    assert!(
+        message.contains("blinding.hdr") && message.contains("MAX_RADIANCE"),
+        "{message}"
+    );
+    let edge = Environment::from_latlong(2, 1, vec![[lightsphere::MAX_RADIANCE; 3], [0.0; 3]]);
+    assert!(edge.is_ok());
+    let above = Environment::from_latlong(2, 1, vec![[lightsphere::MAX_RADIANCE * 1.01; 3]; 2]);
+    assert!(above.is_err());
+}
+
 fn write_flat_hdr(path: &Path, width: usize, height: usize, pixels: &[[u8; 4]]) {
     let mut f = std::fs::File::create(path).unwrap();
     write!(

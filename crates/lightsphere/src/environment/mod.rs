@@ -23,6 +23,12 @@ use std::path::Path;
 /// Largest supported width or height of an environment map, in texels.
 pub const MAX_ENV_DIMENSION: usize = 32_768;
 
+/// Largest accepted texel radiance. The sun's disk is about 2·10⁷ W sr⁻¹ m⁻² and HDR captures
+/// in relative units stay far below that; a texel near f32's limit (a corrupt or crafted RGBE
+/// exponent reaches 10³⁸) overflows the lighting sums and the tone curve's x², rendering black
+/// or NaN pixels instead of an error (issue #12).
+pub const MAX_RADIANCE: f32 = 1e15;
+
 /// Largest supported texel count (2^27 ≈ 134 M texels, 1.6 GB as `[f32; 3]`: a 16k × 8k map).
 pub const MAX_ENV_TEXELS: usize = 1 << 27;
 
@@ -100,8 +106,8 @@ impl Environment {
     /// # Errors
     /// [`LightsphereError::EnvironmentSize`] for a zero or too large size,
     /// [`LightsphereError::TexelCount`] when `texels.len() != width * height`,
-    /// [`LightsphereError::InvalidTexel`] for a negative, NaN or infinite value (the first one
-    /// in row-major order).
+    /// [`LightsphereError::InvalidTexel`] for a negative, NaN or infinite value or one above
+    /// [`MAX_RADIANCE`] (the first one in row-major order).
     pub fn from_latlong(
         width: usize,
         height: usize,
@@ -128,7 +134,7 @@ impl Environment {
         for (i, t) in texels.iter().enumerate() {
             for (channel, &value) in t.iter().enumerate() {
                 // −0.0 is accepted (it compares equal to 0).
-                if !value.is_finite() || value < 0.0 {
+                if !(0.0..=MAX_RADIANCE).contains(&value) {
                     return Err(LightsphereError::InvalidTexel {
                         path: path.map(Path::to_path_buf),
                         row: i / width,
