@@ -257,7 +257,7 @@ pub fn load_environment(
     Ok((env, params))
 }
 
-fn sky_params(scene: &Scene) -> synth::SkyParams {
+pub(crate) fn sky_params(scene: &Scene) -> synth::SkyParams {
     let mut params = synth::SkyParams::default();
     if let Some(e) = scene.synth.sun_elevation_deg {
         params.sun_elevation_deg = e;

@@ -78,20 +78,27 @@ impl RunReport {
         out
     }
 
-    /// Write `run-report.json` and `run-report.txt` into `dir` (atomically each).
+    /// Write `run-report.json` and `run-report.txt` into `dir` (atomically each), naming the
+    /// outputs — these two included, as returned — where they will be once `dir` (a run's
+    /// temporary folder) is renamed to `final_dir`; pass the same folder twice when it is final.
     ///
     /// # Errors
     /// [`Error::Io`] naming the file.
-    pub fn write(&self, dir: &Path) -> Result<(PathBuf, PathBuf), Error> {
-        let json_path = dir.join("run-report.json");
-        let text_path = dir.join("run-report.txt");
+    pub fn write(&mut self, dir: &Path, final_dir: &Path) -> Result<(PathBuf, PathBuf), Error> {
+        // The outputs are named where they will be once `dir` is renamed to `final_dir`.
+        for path in &mut self.outputs {
+            if let Ok(name) = path.strip_prefix(dir) {
+                *path = final_dir.join(name);
+            }
+        }
+        let names = ["run-report.json", "run-report.txt"];
         let json = serde_json::to_string_pretty(self).map_err(|e| Error::Io {
-            path: json_path.clone(),
+            path: final_dir.join(names[0]),
             reason: e.to_string(),
         })?;
-        write_atomic(&json_path, json.as_bytes())?;
-        write_atomic(&text_path, self.table().as_bytes())?;
-        Ok((json_path, text_path))
+        write_atomic(&dir.join(names[0]), json.as_bytes())?;
+        write_atomic(&dir.join(names[1]), self.table().as_bytes())?;
+        Ok((final_dir.join(names[0]), final_dir.join(names[1])))
     }
 }
 

@@ -30,6 +30,9 @@ pub struct RunOptions {
     pub gpu: GpuOptions,
     /// Render this frame range as an image sequence (overrides the scene's `[output] frames`).
     pub frames: Option<FrameRange>,
+    /// Replace an output folder that already holds files (`--force`) once the new one is
+    /// complete; without it such a folder is refused before any work.
+    pub replace_output: bool,
 }
 
 /// What a run produced.
@@ -109,8 +112,13 @@ fn ms_since(start: Instant) -> f64 {
 /// and the GPU adapter is acquired before the first stage so that a machine without one fails
 /// at once.
 ///
+/// `out_dir` (and its missing parents) appear only when the run succeeds: the images and the
+/// report are written into a hidden folder beside it, renamed into place at the end. A folder
+/// that already holds files is refused before any work unless `options.replace_output`.
+///
 /// # Errors
-/// Any [`Error`]; files already written by this run are complete (each is written atomically).
+/// Any [`Error`], including a camera that sees none of the objects and a rendered image that
+/// is non-finite or black where the objects are; nothing is left at `out_dir`.
 pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<RunOutput, Error> {
     let start = Instant::now();
     let pipelines_before = gpu_context::PipelineStats::on_this_thread().render_pipelines;
@@ -119,15 +127,10 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         Some(range) => Some(range),
         None => scene.frame_range()?,
     };
-    // The folder itself is created only after the inputs have loaded (below): a run that
-    // fails on a corrupt mesh or a missing adapter leaves nothing behind.
-    if out_dir.exists() && !out_dir.is_dir() {
-        return Err(Error::Io {
-            path: out_dir.to_owned(),
-            reason: "exists and is not a folder; the run writes its images into a folder"
-                .to_owned(),
-        });
-    }
+    // The folder is built in a hidden temporary folder beside `out_dir`, created only after
+    // the inputs have loaded (below) and renamed into place when every image and the report
+    // are written: a run that fails or is interrupted leaves nothing behind.
+    let existing = folder_output(out_dir, options.replace_output)?;
     let gpu = GpuContext::new(&options.gpu)?;
     let mut timer = Timer { stages: Vec::new() };
 
@@ -136,7 +139,9 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         check_range(scene, &objects, range)?;
     }
     // The camera frames the objects (over the whole range for a sequence), not the ground.
-    let camera = frame_camera(scene, &objects, frames);
+    let (camera, centre, radius) = frame_camera(scene, &objects, frames);
+    // A camera that sees none of the objects is refused before any stage runs.
+    crate::image_checks::check_in_view(scene, &camera, centre, radius)?;
     if let Some(ground) = &scene.ground {
         objects.push(ground_object(ground, &objects, frames));
     }
@@ -170,60 +175,65 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         samples: format.samples,
     };
 
-    std::fs::create_dir_all(out_dir).map_err(|e| Error::Io {
-        path: out_dir.to_owned(),
-        reason: e.to_string(),
-    })?;
-    let mut outputs = Vec::new();
-    let image = match frames {
-        None => {
-            if let Some(lights) = &lights {
-                light_frame(shadowing.as_mut(), &mut objects, lights, &mut timer)?;
+    let mut finished = None;
+    atomic_out::write_dir(out_dir, existing, |tmp| -> Result<(), Error> {
+        let mut outputs = Vec::new();
+        let image = match frames {
+            None => {
+                if let Some(lights) = &lights {
+                    light_frame(shadowing.as_mut(), &mut objects, lights, &mut timer)?;
+                }
+                timer.run(Stage::Render, || {
+                    let (image, params, written) =
+                        render_still(scene, tmp, &gpu, &mut renderer, &objects, &look)?;
+                    outputs = written;
+                    Ok((image, params))
+                })?
             }
-            timer.run(Stage::Render, || {
-                let (image, params, written) =
-                    render_still(scene, out_dir, &gpu, &mut renderer, &objects, &look)?;
+            Some(range) => {
+                let (image, written) = render_sequence(
+                    scene,
+                    tmp,
+                    &gpu,
+                    shadowing.as_mut(),
+                    &mut renderer,
+                    &mut objects,
+                    lights.as_ref(),
+                    &look,
+                    range,
+                    options.progress,
+                    &mut timer,
+                )?;
                 outputs = written;
-                Ok((image, params))
-            })?
-        }
-        Some(range) => {
-            let (image, written) = render_sequence(
-                scene,
-                out_dir,
-                &gpu,
-                shadowing.as_mut(),
-                &mut renderer,
-                &mut objects,
-                lights.as_ref(),
-                &look,
-                range,
-                options.progress,
-                &mut timer,
-            )?;
-            outputs = written;
-            image
-        }
-    };
+                image
+            }
+        };
 
-    if plan.contains(Stage::Btf) {
-        let written = timer.run(Stage::Btf, || {
-            crate::btf_stage::run(scene, out_dir, &gpu, &mut renderer, &objects, &look)
-        })?;
-        outputs.extend(written);
-    }
+        if plan.contains(Stage::Btf) {
+            let written = timer.run(Stage::Btf, || {
+                crate::btf_stage::run(scene, tmp, &gpu, &mut renderer, &objects, &look)
+            })?;
+            outputs.extend(written);
+        }
 
-    let mut report = RunReport {
-        scene: scene.name.clone(),
-        origin: scene.origin.clone(),
-        effects: plan.effects().iter().map(|e| e.name().to_owned()).collect(),
-        stages: timer.stages,
-        total_millis: 0.0,
-        outputs,
-    };
-    report.total_millis = ms_since(start);
-    let (json_path, text_path) = report.write(out_dir)?;
-    report.outputs.extend([json_path, text_path]);
+        let mut report = RunReport {
+            scene: scene.name.clone(),
+            origin: scene.origin.clone(),
+            effects: plan.effects().iter().map(|e| e.name().to_owned()).collect(),
+            stages: timer.stages,
+            total_millis: 0.0,
+            outputs,
+        };
+        report.total_millis = ms_since(start);
+        let (json, text) = report.write(tmp, out_dir)?;
+        report.outputs.extend([json, text]);
+        finished = Some((image, report));
+        Ok(())
+    })?;
+    let (image, report) = finished.ok_or_else(|| Error::Io {
+        path: out_dir.to_owned(),
+        reason: "the run's folder was written without its report".to_owned(),
+    })?;
     Ok(RunOutput {
         report,
         image,
@@ -231,6 +241,29 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         pipelines_built: gpu_context::PipelineStats::on_this_thread().render_pipelines
             - pipelines_before,
     })
+}
+
+/// How a folder output treats an existing folder at `out`: refused before any work when it
+/// holds files (or is a file) and `replace` (`--force`) is not given — old frames would sit
+/// beside new ones, or a shorter clip would overwrite the start of a longer one and look
+/// complete — else replaced once the new folder is complete ([`atomic_out::write_dir`]).
+///
+/// # Errors
+/// [`Error::Request`] naming the folder and `--force`.
+pub fn folder_output(out: &Path, replace: bool) -> Result<atomic_out::ExistingFolder, Error> {
+    if replace {
+        return Ok(atomic_out::ExistingFolder::Replace);
+    }
+    let holds_files = std::fs::read_dir(out).is_ok_and(|mut entries| entries.next().is_some());
+    if holds_files || (out.exists() && !out.is_dir()) {
+        return Err(Error::Request {
+            path: out.to_owned(),
+            message: "exists and is not an empty folder; choose a new folder, or pass --force \
+                      to replace it once the new output is complete"
+                .to_owned(),
+        });
+    }
+    Ok(atomic_out::ExistingFolder::Refuse)
 }
 
 /// What every image of a run shares: the camera, the background and where it was drawn.
@@ -263,7 +296,12 @@ fn background(scene: &Scene, has_environment: bool) -> Background {
 /// The scene's camera: framed on the bounding sphere of the vertices the objects' triangles
 /// use (a stray unreferenced vertex does not shrink the picture), over every frame of `range`
 /// for a sequence, so the camera holds still.
-fn frame_camera(scene: &Scene, objects: &[WorldObject], range: Option<FrameRange>) -> Camera {
+/// Returns the camera and the sphere (centre, radius) it frames.
+fn frame_camera(
+    scene: &Scene,
+    objects: &[WorldObject],
+    range: Option<FrameRange>,
+) -> (Camera, Vec3, f32) {
     let mut points = Vec::new();
     for o in objects {
         let used = o.used_vertices();
@@ -280,7 +318,8 @@ fn frame_camera(scene: &Scene, objects: &[WorldObject], range: Option<FrameRange
         }
     }
     let (centre, radius) = bounding_sphere(&points).unwrap_or((Vec3::ZERO, 1.0));
-    crate::camera::resolve(&scene.camera, centre, radius)
+    let camera = crate::camera::resolve(&scene.camera, centre, radius);
+    (camera, centre, radius)
 }
 
 /// A ground grid under the objects: at their lowest point (over the range), centred under
@@ -403,9 +442,11 @@ pub fn render_still_image(
     environment: Option<&lightsphere::Environment>,
 ) -> Result<(HdrImage, Display, Background), Error> {
     let (mut renderer, background, _) = renderer_for(scene, gpu, environment);
-    let camera = frame_camera(scene, objects, None);
+    let (camera, centre, radius) = frame_camera(scene, objects, None);
+    crate::image_checks::check_in_view(scene, &camera, centre, radius)?;
     set_gouraud_meshes(gpu, &mut renderer, objects, &camera, &[])?;
     let image = renderer.render(&gpu.device, &gpu.queue, &camera, background, &[])?;
+    crate::image_checks::check_rendered(scene, &image, None)?;
     let display = display_for(scene, &image);
     Ok((image, display, background))
 }
@@ -521,6 +562,7 @@ fn render_still(
 ) -> Result<(HdrImage, serde_json::Value, Vec<PathBuf>), Error> {
     set_gouraud_meshes(gpu, renderer, objects, &look.camera, &[])?;
     let image = renderer.render(&gpu.device, &gpu.queue, &look.camera, look.background, &[])?;
+    crate::image_checks::check_rendered(scene, &image, None)?;
     let display = display_for(scene, &image);
     let written = write_images(
         &image,
@@ -590,6 +632,7 @@ fn render_sequence(
         let t = Instant::now();
         set_gouraud_meshes(gpu, renderer, objects, &look.camera, &[])?;
         let image = renderer.render(&gpu.device, &gpu.queue, &look.camera, look.background, &[])?;
+        crate::image_checks::check_rendered(scene, &image, Some(f))?;
         FrameTimes::add(&mut render_t, ms_since(t));
         let t = Instant::now();
         let d = *display.get_or_insert_with(|| display_for(scene, &image));

@@ -172,6 +172,29 @@ fn a_sky_too_wide_for_any_use_is_refused_by_key_before_any_work() {
     assert!(!out.exists(), "the output folder is not created");
 }
 
+#[test]
+fn sky_values_the_generator_refuses_are_named_by_scene_key_before_any_work() {
+    // Issue #12: `sun_elevation_deg = 120` was refused by the generator after work started,
+    // named `SkyParams::sun_elevation_deg`.
+    let dir = tempfile::tempdir().unwrap();
+    for (value, key) in [
+        ("sun_elevation_deg = 120.0", "synth.sun_elevation_deg"),
+        ("sun_elevation_deg = -5.0", "synth.sun_elevation_deg"),
+        ("sun_azimuth_deg = inf", "synth.sun_azimuth_deg"),
+    ] {
+        let text = format!(
+            "[[object]]\nname = \"cloth\"\nsource = \"synth:cloth\"\n\
+             [environment]\nsource = \"synth:sky\"\n[synth]\n{value}\n"
+        );
+        let scene = Scene::from_toml(&text, dir.path(), "sky.toml").unwrap();
+        let message = scene.validate().unwrap_err().to_string();
+        assert!(
+            message.contains("sky.toml") && message.contains(key),
+            "{value}: {message}"
+        );
+    }
+}
+
 #[cfg(unix)]
 #[test]
 fn a_scene_file_that_is_a_fifo_is_refused_by_name() {
@@ -183,4 +206,75 @@ fn a_scene_file_that_is_a_fifo_is_refused_by_name() {
         message.contains("scene.toml") && message.contains("FIFO"),
         "{message}"
     );
+}
+
+/// Issue #12: "a degenerate camera renders blank with exit 0; huge but finite radiance renders
+/// black with exit 0". A camera looking away from the objects is refused before any stage, by
+/// its keys; one whose view holds the objects' bounding sphere but no triangle (two specks far
+/// apart, the camera between them) is refused on the rendered coverage; objects that render
+/// all black (albedo 0) are refused; an environment brighter than `MAX_RADIANCE` is refused
+/// when it loads. No output folder is left by any of them.
+#[test]
+fn blank_black_and_blinding_renders_are_refused_with_no_output() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let speck = |x: f32| format!("v {x} 0 0\nv {} 0 0\nv {x} 0.01 0\nf 1 2 3\n", x + 0.01);
+    std::fs::write(dir.path().join("left.obj"), speck(-10.0)).unwrap();
+    std::fs::write(dir.path().join("right.obj"), speck(10.0)).unwrap();
+    // RGBE exponent 255: 6.6e35 per channel, finite.
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n".to_vec();
+    hdr.extend([255u8; 32]);
+    std::fs::write(dir.path().join("blinding.hdr"), hdr).unwrap();
+    let cloth = "[[object]]\nname = \"cloth\"\nsource = \"synth:cloth\"\nframe = -1\n";
+    let specks = "[[object]]\nname = \"l\"\nsource = \"left.obj\"\n\
+                  [[object]]\nname = \"r\"\nsource = \"right.obj\"\n";
+    let lit = "[environment]\nsource = \"synth:sky\"\n[lighting]\nlevel = 1\n";
+    let blinding = "[environment]\nsource = \"blinding.hdr\"\n[lighting]\nlevel = 1\n";
+    // (name, objects and environment, camera keys, what the error names)
+    let cases: [(&str, String, &str, &[&str]); 4] = [
+        (
+            "away",
+            cloth.to_owned(),
+            "eye = [0.0, 0.0, 50.0]\ntarget = [0.0, 0.0, 100.0]\n",
+            &["camera.eye", "camera.target", "no object is in view"],
+        ),
+        (
+            "between",
+            specks.to_owned(),
+            "eye = [0.0, 0.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nfov_deg = 5.0\n",
+            &["no object covers a pixel", "camera.eye"],
+        ),
+        (
+            "black",
+            format!("effects = [\"lighting\"]\n{cloth}albedo = [0.0, 0.0, 0.0]\n{lit}"),
+            "",
+            &["object pixels are black", "albedo 0"],
+        ),
+        (
+            "blinding",
+            format!("effects = [\"lighting\"]\n{cloth}{blinding}"),
+            "",
+            &["blinding.hdr", "MAX_RADIANCE"],
+        ),
+    ];
+    for (name, body, camera, needles) in cases {
+        let text =
+            format!("{body}[output]\npng = \"a.png\"\n[camera]\nwidth = 48\nheight = 32\n{camera}");
+        let scene = Scene::from_toml(&text, dir.path(), &format!("{name}.toml")).unwrap();
+        let out = dir.path().join(format!("out-{name}"));
+        let err = run_scene(&scene, &out, &RunOptions::default())
+            .err()
+            .unwrap_or_else(|| panic!("{name}: rendered without an error"));
+        let message = err.to_string();
+        for n in needles {
+            assert!(message.contains(n), "{name}: {message:?} lacks {n:?}");
+        }
+        assert!(
+            !out.exists(),
+            "{name}: the failed run left {}",
+            out.display()
+        );
+    }
 }

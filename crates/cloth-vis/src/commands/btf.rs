@@ -27,8 +27,10 @@ pub struct SynthRequest {
     pub params: synth::WovenBtfParams,
     /// The measured direction set, H1 or H2 (Table 5.1).
     pub sampling: Sampling,
-    /// The folder to create; it must not exist or be empty.
+    /// The folder to create; it must not exist or be empty unless `force`.
     pub out: PathBuf,
+    /// Replace an `out` that holds files, once the new folder is complete.
+    pub force: bool,
     /// Show a progress bar on stderr.
     pub progress: bool,
 }
@@ -175,25 +177,13 @@ fn dir_bytes(dir: &Path) -> u64 {
 /// parameters ([`Error::Synth`]); write errors. On error nothing is left at `out`.
 pub fn run_synth(request_: &SynthRequest) -> Result<SynthSummary, Error> {
     let out = &request_.out;
-    let existing = super::folder_output(out, false)?;
+    let existing = super::folder_output(out, request_.force)?;
     let woven = synth::WovenBtf::new(&request_.params)?;
     let start = Instant::now();
-    let parent = out
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).map_err(|e| Error::Io {
-        path: parent.to_owned(),
-        reason: format!("cannot create the folder: {e}"),
-    })?;
     // Built in a hidden folder beside `out` and renamed into place when all 6,561 images are
     // written; removed on error and on SIGINT/SIGTERM.
-    atomic_out::write_dir(out, existing, |temp| write_views(&woven, request_, temp)).map_err(
-        |e| match e {
-            atomic_out::AtomicError::Writer(e) => e,
-            atomic_out::AtomicError::File(e) => Error::from(e),
-        },
-    )?;
+    atomic_out::write_dir(out, existing, |temp| write_views(&woven, request_, temp))
+        .map_err(Error::from)?;
     Ok(SynthSummary {
         res: woven.res(),
         sampling: request_.sampling,
@@ -529,6 +519,7 @@ impl BtfCommand {
                 },
                 sampling: a.sampling,
                 out: a.out,
+                force: a.force,
                 progress: !a.quiet,
             })?
             .line(),
@@ -563,9 +554,12 @@ pub struct SynthArgs {
     /// Rays per texel side (anti-aliasing of the mesostructure).
     #[arg(long, default_value_t = synth::WovenBtfParams::default().supersample)]
     supersample: usize,
-    /// Output folder (must not exist, or be empty).
+    /// Output folder (must not exist, or be empty; created with its parents).
     #[arg(long)]
     out: PathBuf,
+    /// Replace an output folder that already holds files, once the new one is complete.
+    #[arg(long)]
+    force: bool,
     /// Hide the progress bar.
     #[arg(long)]
     quiet: bool,

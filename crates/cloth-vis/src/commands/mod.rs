@@ -31,31 +31,7 @@ pub fn required_gpu(path: &std::path::Path, flag: &str) -> Result<GpuContext, cl
         .map_err(|e| invalid(path, format!("{flag} renders on the GPU: {e}")))
 }
 
-/// How a folder output treats an existing folder at `out`: refused before any work when it
-/// holds files and `force` is not given (old frames would sit beside new ones, or a shorter
-/// clip would overwrite the start of a longer one and look complete), else replaced once the
-/// new folder is complete (`atomic_out::write_dir`).
-///
-/// # Errors
-/// [`cloth_vis::Error::Request`] naming the folder and `--force`.
-pub fn folder_output(
-    out: &std::path::Path,
-    force: bool,
-) -> Result<atomic_out::ExistingFolder, cloth_vis::Error> {
-    if force {
-        return Ok(atomic_out::ExistingFolder::Replace);
-    }
-    let holds_files = std::fs::read_dir(out).is_ok_and(|mut entries| entries.next().is_some());
-    if holds_files || out.is_file() {
-        return Err(invalid(
-            out,
-            "exists and is not an empty folder; choose a new folder, or pass --force to replace \
-             it once the new frames are complete"
-                .to_owned(),
-        ));
-    }
-    Ok(atomic_out::ExistingFolder::Refuse)
-}
+pub use cloth_vis::folder_output;
 
 /// A request refused before any work: [`cloth_vis::Error::Request`] naming `path`.
 pub fn invalid(path: &std::path::Path, message: String) -> cloth_vis::Error {

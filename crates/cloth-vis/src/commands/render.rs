@@ -12,9 +12,13 @@ use render::sequence::FrameRange;
 pub struct RenderArgs {
     /// The scene (TOML).
     scene: PathBuf,
-    /// Output folder (created if missing).
+    /// Output folder (created with its parents; built beside and renamed into place when
+    /// complete).
     #[arg(long)]
     out: PathBuf,
+    /// Replace an output folder that already holds files, once the new one is complete.
+    #[arg(long)]
+    force: bool,
     /// Render frames A..B of the scene's animated objects to frame-NNNN.png (overrides
     /// `[output] frames`).
     #[arg(long, value_name = "A..B")]
@@ -31,6 +35,7 @@ impl RenderArgs {
         let options = RunOptions {
             progress: !self.quiet,
             frames: self.frames,
+            replace_output: self.force,
             ..RunOptions::default()
         };
         let output = cloth_vis::run_scene(&scene, &self.out, &options)?;
@@ -42,9 +47,13 @@ impl RenderArgs {
 /// Render the embedded demo scene (synthetic cloth under a procedural sky) into DIR.
 #[derive(clap::Args)]
 pub struct DemoArgs {
-    /// Output folder (created if missing).
+    /// Output folder (created with its parents; built beside and renamed into place when
+    /// complete).
     #[arg(long)]
     out: PathBuf,
+    /// Replace an output folder that already holds files, once the new one is complete.
+    #[arg(long)]
+    force: bool,
     /// Render frames A..B of the cloth animation (120 frames: 0..120) to frame-NNNN.png,
     /// with the visibility recomputed per frame.
     #[arg(long, value_name = "A..B")]
@@ -60,6 +69,7 @@ impl DemoArgs {
         let options = RunOptions {
             progress: !self.quiet,
             frames: self.frames,
+            replace_output: self.force,
             ..RunOptions::default()
         };
         let output = cloth_vis::run_demo(&self.out, &options)?;

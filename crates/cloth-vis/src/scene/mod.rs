@@ -647,6 +647,18 @@ impl Scene {
                 ));
             }
         }
+        // The sky the scene's `[synth]` keys set, checked by the generator itself but refused
+        // here, before any work, by the scene's key rather than the library's field.
+        if let Err(e) = crate::inputs::sky_params(self).validate() {
+            let key = match &e {
+                synth::SynthError::InvalidParameter { field, .. }
+                | synth::SynthError::TooLarge { field, .. } => match field.rsplit("::").next() {
+                    Some(f @ ("sun_elevation_deg" | "sun_azimuth_deg")) => format!("synth.{f}"),
+                    _ => "synth.sky_width".to_owned(),
+                },
+            };
+            return Err(self.invalid(&key, e.to_string()));
+        }
         if let Some(env) = &self.environment {
             let s = env.prefilter_sigma_deg;
             if !(s.is_finite() && (0.0..=90.0).contains(&s)) {
@@ -669,6 +681,7 @@ impl Scene {
             ));
         }
         let cam = &self.camera;
+        crate::camera::check_desc(cam).map_err(|(key, message)| self.invalid(key, message))?;
         for (key, side) in [("camera.width", cam.width), ("camera.height", cam.height)] {
             if side == 0 || side > MAX_IMAGE_SIDE {
                 return Err(self.invalid(key, format!("{side} is outside 1..={MAX_IMAGE_SIDE}")));

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 /// The `cloth-vis` executable cargo built beside this test executable (`target/<profile>/`
 /// holds it, `target/<profile>/deps/` this test; the way `assert_cmd::cargo_bin` finds it).
 /// Cargo builds the binary for the package's integration tests before any test runs.
-fn binary() -> PathBuf {
+pub fn binary() -> PathBuf {
     let exe = std::env::current_exe().expect("the test executable has a path");
     let profile_dir = exe
         .parent()

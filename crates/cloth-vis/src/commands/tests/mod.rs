@@ -5,5 +5,6 @@ mod common;
 
 mod anim_compress;
 mod anim_jumpmap;
+mod render_outputs;
 mod visibility_cmd;
 mod visibility_outputs;
