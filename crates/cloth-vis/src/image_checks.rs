@@ -45,6 +45,21 @@ pub(crate) fn check_in_view(
     centre: Vec3,
     radius: f32,
 ) -> Result<(), Error> {
+    // The resolved camera (e.g. an eye straight above the objects' centre with the default up)
+    // refused by the scene's keys rather than later by the renderer.
+    if let Err(e) = camera.validate() {
+        let key = match e.name {
+            "fov_y_deg" => "fov_deg",
+            other => other,
+        };
+        return Err(Error::Scene {
+            origin: scene.origin.clone(),
+            message: format!(
+                "camera.{key} = {} once framed on the objects (eye {}, target {}): {}",
+                e.value, camera.eye, camera.target, e.reason
+            ),
+        });
+    }
     if sphere_in_view(camera, centre, radius) {
         return Ok(());
     }

@@ -232,13 +232,22 @@ fn blank_black_and_blinding_renders_are_refused_with_no_output() {
                   [[object]]\nname = \"r\"\nsource = \"right.obj\"\n";
     let lit = "[environment]\nsource = \"synth:sky\"\n[lighting]\nlevel = 1\n";
     let blinding = "[environment]\nsource = \"blinding.hdr\"\n[lighting]\nlevel = 1\n";
+    let ball = "[[object]]\nname = \"ball\"\nsource = \"synth:cloth-obstacle\"\n";
     // (name, objects and environment, camera keys, what the error names)
-    let cases: [(&str, String, &str, &[&str]); 4] = [
+    let cases: [(&str, String, &str, &[&str]); 5] = [
         (
             "away",
             cloth.to_owned(),
             "eye = [0.0, 0.0, 50.0]\ntarget = [0.0, 0.0, 100.0]\n",
             &["camera.eye", "camera.target", "no object is in view"],
+        ),
+        (
+            // Below the ball's centre, looking up at it with the default up vector: a camera
+            // that only exists once framed, refused by its key before any stage.
+            "below",
+            ball.to_owned(),
+            "eye = [0.0, 0.0, 0.0]\n",
+            &["camera.up", "once framed on the objects"],
         ),
         (
             "between",
