@@ -5,6 +5,10 @@
 # copy each into fuzz/regressions/<target>/ once fixed, and CI replays it.
 #
 #   fuzz/run.sh SECONDS [TARGET...]      (from the repository root; default: all targets)
+#   RUNS=1000000 fuzz/run.sh 3600 hdr    (stop each target after RUNS executions instead)
+#
+# Besides the shared data, fuzz/seeds/<target>/ holds small valid files of our own formats
+# (.cpca, .btfpca, .npy, a morph-target .gltf, a BTF image) that no real data set provides.
 #
 # Needs `cargo install cargo-fuzz`. Runs on the stable toolchain through RUSTC_BOOTSTRAP=1.
 set -euo pipefail
@@ -24,6 +28,7 @@ seed() { # seed TARGET FILES...
     # files slow every execution. Larger real files are cut to their first 64 KB.
     [ -f "$f" ] && head -c 65536 "$f" > "$dir/seed-$(basename "$f" | tr ' ' _)"
   done
+  cp fuzz/seeds/"${dir##*/}"/* "$dir"/ 2>/dev/null || true
   cp fuzz/regressions/"${dir##*/}"/* "$dir"/ 2>/dev/null || true
 }
 seed ply "$shared"/meshes/bun_zipper_res4.ply data/bad/*.ply
@@ -43,7 +48,7 @@ cargo fuzz build --release
 for t in "${targets[@]}"; do
   echo "== $t (${seconds}s)"
   cargo fuzz run --release "$t" "fuzz/corpus/$t" -- \
-    -max_total_time="$seconds" -rss_limit_mb=1024 -malloc_limit_mb=512 -timeout=10 \
-    -print_final_stats=1 2>&1 | grep -E "^(stat::|Done|==|SUMMARY|INFO: -max_total_time)|ERROR|crash-|leak-|oom-|timeout-" || true
+    -max_total_time="$seconds" ${RUNS:+-runs=$RUNS} -rss_limit_mb=1024 -malloc_limit_mb=512 -timeout=10 \
+    -print_final_stats=1 2>&1 | grep -E "^(stat::|Done|==|SUMMARY|INFO: -max_total_time|#[0-9]+ *DONE)|ERROR|crash-|leak-|oom-|timeout-" || true
   echo "corpus: $(ls "fuzz/corpus/$t" | wc -l) inputs"
 done
