@@ -72,6 +72,8 @@ pub struct JumpMapRequest {
     pub out: PathBuf,
     /// Replace an output folder that holds files (else refused before any work).
     pub force: bool,
+    /// Most bytes of generated positions held in memory ([`MAX_GENERATED_BYTES`] by default).
+    pub memory_limit: u64,
     /// Folder for the heat maps `D.png`, `D_velocity.png`, `P.png`, `P_velocity.png`,
     /// `P_hat.png` (`None`: none written).
     pub maps: Option<PathBuf>,
@@ -114,8 +116,8 @@ impl JumpMapSummary {
     }
 }
 
-/// Most bytes of generated positions (F × V × 12) one `anim jumpmap` run holds: 4 GB, e.g.
-/// 100,000 frames of a 3,000-vertex cloth.
+/// Most bytes of generated positions (F × V × 12) one `anim jumpmap` run holds by default:
+/// 4 GB, e.g. 100,000 frames of a 3,000-vertex cloth; `--memory-gb` raises it.
 pub const MAX_GENERATED_BYTES: u64 = 4_000_000_000;
 
 /// The kind of output `out` names.
@@ -199,18 +201,19 @@ pub fn run_jumpmap(
     // The generated run is held in memory before it is written: bound it by a named limit
     // rather than growing until the kernel kills the process (issue #12).
     let run_bytes = (request.frames as u128) * (clip.vertex_count() as u128) * 12;
-    if run_bytes > MAX_GENERATED_BYTES as u128 {
+    if run_bytes > u128::from(request.memory_limit) {
         return Err(invalid(
             out,
             format!(
-                "--frames {}: {} frames of {} vertices take {:.1} GB, above the {} GB this \
-                 command holds in memory; generate fewer frames per run (the jump map is \
-                 endless: run again with another --seed for more)",
+                "--frames {}: {} frames of {} vertices take {:.1} GB, above the {:.1} GB this \
+                 command holds in memory (--memory-gb); generate fewer frames per run (the \
+                 jump map is endless: run again with another --seed for more), or raise \
+                 --memory-gb on a machine that has it",
                 request.frames,
                 request.frames,
                 clip.vertex_count(),
                 run_bytes as f64 / 1e9,
-                MAX_GENERATED_BYTES / 1_000_000_000
+                request.memory_limit as f64 / 1e9
             ),
         ));
     }
@@ -589,6 +592,9 @@ pub struct JumpmapArgs {
     /// Replace an existing output folder that holds files, once the new frames are complete.
     #[arg(long)]
     force: bool,
+    /// Most gigabytes of generated positions (frames × vertices × 12 bytes) held in memory.
+    #[arg(long, default_value_t = MAX_GENERATED_BYTES as f64 / 1e9, value_parser = parse_memory_gb)]
+    memory_gb: f64,
     /// Folder for the heat maps of D, D*, P, P*, P̂ (PNG).
     #[arg(long)]
     maps: Option<PathBuf>,
@@ -613,6 +619,14 @@ pub struct JumpmapArgs {
         default_value = "256x256"
     )]
     strip_size: [u32; 2],
+}
+
+/// `--memory-gb`: a finite number of gigabytes > 0.
+fn parse_memory_gb(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(gb) if gb.is_finite() && gb > 0.0 && gb <= 1e6 => Ok(gb),
+        _ => Err(format!("{text:?} is not a number of gigabytes in (0, 1e6]")),
+    }
 }
 
 impl JumpmapArgs {
@@ -648,6 +662,7 @@ impl JumpmapArgs {
             frames: self.frames,
             out: self.out,
             force: self.force,
+            memory_limit: (self.memory_gb * 1e9) as u64,
             maps: self.maps,
             strip: self.strip.map(|path| StripRequest {
                 path,

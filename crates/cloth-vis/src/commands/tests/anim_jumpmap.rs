@@ -66,9 +66,16 @@ fn request(input: PathBuf, out: PathBuf) -> JumpMapRequest {
         frames: 200,
         out,
         force: false,
+        memory_limit: crate::commands::jumpmap::MAX_GENERATED_BYTES,
         maps: None,
         strip: None,
     }
+}
+
+/// (frames, vertices) of a clip on disk.
+fn clip_size(path: &Path) -> (usize, usize) {
+    let (clip, _) = meshio::load_animation(path, &meshio::AnimationOptions::default()).unwrap();
+    (clip.frames.len(), clip.vertex_count())
 }
 
 fn read_npy(path: &Path) -> (Vec<usize>, Vec<f32>) {
@@ -184,7 +191,19 @@ fn bad_requests_are_refused_before_writing() {
     r.frames = 1_000_000_000;
     let e = run_jumpmap(&r, None).unwrap_err().to_string();
     assert!(e.contains("--frames 1000000000") && e.contains("GB"), "{e}");
+    assert!(e.contains("--memory-gb"), "the override is named: {e}");
     assert!(!out.exists());
+    // The limit is the request's: a run just above a lowered limit is refused, one below it
+    // goes through.
+    let mut r = request(dir.path().join("clip"), out.clone());
+    r.frames = 20;
+    let (_, vertices) = clip_size(&dir.path().join("clip"));
+    r.memory_limit = (20 * vertices * 12 - 1) as u64;
+    let e = run_jumpmap(&r, None).unwrap_err().to_string();
+    assert!(e.contains("--frames 20"), "{e}");
+    r.memory_limit = (20 * vertices * 12) as u64;
+    run_jumpmap(&r, None).unwrap();
+    assert!(out.exists());
 }
 
 /// A GPU context, or `None` after the project's skip policy (fails under CI). Lavapipe wants
