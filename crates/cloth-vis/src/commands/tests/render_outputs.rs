@@ -8,8 +8,6 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use gpu_context::{GpuContext, GpuOptions};
-
 use super::common::{binary, cli_env, text};
 
 /// Lavapipe wants `XDG_RUNTIME_DIR`.
@@ -27,14 +25,9 @@ fn names(dir: &Path) -> Vec<String> {
     names
 }
 
+/// Whether a GPU adapter exists (gpu-context's skip policy: a warning, or a failure under CI).
 fn have_gpu() -> bool {
-    match GpuContext::new(&GpuOptions::default()) {
-        Ok(_) => true,
-        Err(e) => {
-            test_data::skip::<()>(&format!("no GPU adapter: {e}"));
-            false
-        }
-    }
+    gpu_context::testing::gpu_or_skip().is_some()
 }
 
 #[test]
