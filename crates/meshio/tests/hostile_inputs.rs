@@ -5,8 +5,9 @@
 //!
 //! The resource policy's target: any input under 1 MB loads, or is refused, within 256 MB.
 //! A counting global allocator measures the peak of each load exactly (bytes requested from the
-//! allocator, not pages touched); the loads run one at a time under a lock so that each peak
-//! is its own.
+//! allocator, not pages touched). Every test holds one lock for its whole body, so that no
+//! other test's allocations (a read-back, a fixture) land inside a measured peak, whatever
+//! the number of test threads.
 
 #![allow(unsafe_code)] // the counting allocator below; nothing else.
 
@@ -73,10 +74,14 @@ static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
 /// The policy's bound for inputs under 1 MB.
 const PEAK_LIMIT: usize = 256 << 20;
 
-/// Runs `load` alone and returns its result with the peak bytes it allocated beyond what was
-/// live when it started.
+/// Taken first by every test: the process's allocations are then this test's alone.
+fn alone() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Runs `load` and returns its result with the peak bytes it allocated beyond what was live
+/// when it started; the caller holds [`alone`].
 fn peak_of<T>(load: impl FnOnce() -> T) -> (T, usize) {
-    let _alone = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let base = CURRENT.load(Ordering::Relaxed);
     PEAK.store(base, Ordering::Relaxed);
     let result = load();
@@ -144,6 +149,7 @@ fn viewless_gltf(dir: &Path, name: &str, count: u64, instances: usize, targets: 
 
 #[test]
 fn a_viewless_accessor_claiming_gigabytes_is_refused_within_the_limit() {
+    let _alone = alone();
     // C4: 600 bytes, POSITION count 3·2^24 without a buffer view, loaded with 3.4 GB.
     let dir = tempfile::tempdir().unwrap();
     let path = viewless_gltf(dir.path(), "c4.gltf", 3 << 24, 1, 0);
@@ -152,6 +158,7 @@ fn a_viewless_accessor_claiming_gigabytes_is_refused_within_the_limit() {
 
 #[test]
 fn one_mesh_instantiated_thousands_of_times_is_refused_within_the_limit() {
+    let _alone = alone();
     // C5: the same mesh listed 6,000 times in scenes[0].nodes aborted at 6.8 GB.
     let dir = tempfile::tempdir().unwrap();
     let path = viewless_gltf(dir.path(), "c5.gltf", 300_000, 6_000, 0);
@@ -160,6 +167,7 @@ fn one_mesh_instantiated_thousands_of_times_is_refused_within_the_limit() {
 
 #[test]
 fn hundreds_of_empty_morph_targets_are_refused_within_the_limit() {
+    let _alone = alone();
     // C5: 400 empty morph targets `{}` took 3.7 GB from 2 KB.
     let dir = tempfile::tempdir().unwrap();
     let path = viewless_gltf(dir.path(), "targets.gltf", 1_000_000, 1, 400);
@@ -168,6 +176,7 @@ fn hundreds_of_empty_morph_targets_are_refused_within_the_limit() {
 
 #[test]
 fn a_small_real_expansion_still_loads() {
+    let _alone = alone();
     // The budget's floor leaves room for what real assets do: a sparse-style zero accessor of
     // 100,000 vertices (1.2 MB decoded) instantiated by 8 nodes loads.
     let dir = tempfile::tempdir().unwrap();
@@ -180,6 +189,7 @@ fn a_small_real_expansion_still_loads() {
 
 #[test]
 fn a_property_less_element_and_empty_npy_frames_stay_within_the_limit() {
+    let _alone = alone();
     // C1 and C2 measured: both refused before any allocation of their claimed size.
     let dir = tempfile::tempdir().unwrap();
     let ply = write(
@@ -216,6 +226,7 @@ fn gltf_with_uri(dir: &Path, uri: &str) -> PathBuf {
 
 #[test]
 fn buffer_uris_stay_inside_the_assets_folder() {
+    let _alone = alone();
     // `"uri": "/etc/passwd"` loaded its bytes as vertex positions; `/dev/zero` read until
     // memory ran out; `..` escaped the folder.
     let root = tempfile::tempdir().unwrap();
@@ -256,6 +267,7 @@ fn buffer_uris_stay_inside_the_assets_folder() {
 #[cfg(unix)]
 #[test]
 fn fifos_are_refused_by_name_without_hanging() {
+    let _alone = alone();
     // A FIFO as the mesh, and as a glTF buffer inside the folder: nobody writes to either, so
     // a reader that opened them would block forever.
     let dir = tempfile::tempdir().unwrap();
@@ -291,6 +303,7 @@ fn fifos_are_refused_by_name_without_hanging() {
 /// writer stays under ten frames' worth (6 MB).
 #[test]
 fn streamed_glb_animation_holds_two_frames_not_the_clip() {
+    let _alone = alone();
     let (frames, vertices) = (128, 50_000);
     let triangles: Vec<[u32; 3]> = (0..vertices as u32 - 2)
         .map(|i| [i, i + 1, i + 2])

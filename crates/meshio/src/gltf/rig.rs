@@ -5,6 +5,12 @@
 //!
 //! Instances are merged in scene traversal order (depth first, children in file order); each
 //! primitive's vertices follow the previous one's, and its indices are offset accordingly.
+//! A mesh instantiated by several nodes is decoded once and shared; each instance charges the
+//! decode budget for the merged vertices and triangles it adds, so a small file listing one
+//! mesh thousands of times is refused before the merge allocates.
+
+use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::{Mat4, Quat, Vec2, Vec3};
 use gltf::Semantic;
@@ -47,6 +53,26 @@ pub(crate) struct Influences {
     pub weights: Vec<f32>,
 }
 
+/// Bytes the merged scene holds per vertex an instance adds, charged to the decode budget:
+/// positions and normals (12 + 12) and UVs (8) in the rig, and the copies the mesh or animation
+/// finish makes of them (positions, normalised normals, UVs: 32).
+const MERGED_BYTES_PER_VERTEX: u64 = 64;
+
+/// Bytes the merged scene holds per triangle an instance adds: the rig's list and the copy
+/// handed to validation (12 + 12).
+const MERGED_BYTES_PER_TRIANGLE: u64 = 24;
+
+/// One primitive as decoded, shared by every instance of its mesh.
+struct Decoded {
+    primitive: Arc<Primitive>,
+    /// Local (unoffset) triangles.
+    triangles: Vec<[u32; 3]>,
+    uvs: Option<Vec<Vec2>>,
+}
+
+/// Decoded meshes by (mesh index, joint count of the instancing node's skin).
+type DecodedMeshes = HashMap<(usize, Option<usize>), Arc<Vec<Decoded>>>;
+
 pub(crate) struct Primitive {
     /// Triangles this primitive contributes to the merged list.
     pub triangle_count: usize,
@@ -60,7 +86,7 @@ pub(crate) struct Primitive {
 pub(crate) struct Instance {
     pub node: usize,
     pub skin: Option<usize>,
-    pub primitives: Vec<Primitive>,
+    pub primitives: Vec<Arc<Primitive>>,
     pub default_weights: Vec<f32>,
 }
 
@@ -145,12 +171,13 @@ impl Rig {
             notes: Vec::new(),
         };
         let mut stack: Vec<usize> = roots.into_iter().rev().collect();
+        let mut decoded = DecodedMeshes::new();
         while let Some(index) = stack.pop() {
             let Some(node) = doc.nodes().nth(index) else {
                 continue;
             };
             if let Some(mesh) = node.mesh() {
-                rig.add_instance(src, &node, &mesh)?;
+                rig.add_instance(src, &node, &mesh, &mut decoded)?;
             }
             stack.extend(
                 node.children()
@@ -169,6 +196,7 @@ impl Rig {
         src: &GltfSource,
         node: &gltf::Node<'_>,
         mesh: &gltf::Mesh<'_>,
+        decoded: &mut DecodedMeshes,
     ) -> Result<(), MeshIoError> {
         let skin = node.skin().map(|s| s.index());
         let target_count = self.nodes[node.index()].morph_targets;
@@ -185,45 +213,46 @@ impl Rig {
                 ),
             ));
         }
-        let mut primitives = Vec::new();
-        for primitive in mesh.primitives() {
-            let what = format!("mesh {} primitive {}", mesh.index(), primitive.index());
-            let (prim, triangles, uvs) = read_primitive(
-                src,
-                &primitive,
-                &what,
-                skin.map(|s| self.skins[s].joints.len()),
-            )?;
-            if prim.morph_positions.len() != target_count {
-                return Err(src.error(
-                    &what,
-                    format!(
-                        "has {} morph targets, the mesh's first primitive {target_count}",
-                        prim.morph_positions.len()
-                    ),
-                ));
+        let joint_count = skin.map(|s| self.skins[s].joints.len());
+        let parts = match decoded.get(&(mesh.index(), joint_count)) {
+            Some(parts) => Arc::clone(parts),
+            None => {
+                let parts = Arc::new(decode_mesh(src, mesh, joint_count, target_count)?);
+                decoded.insert((mesh.index(), joint_count), Arc::clone(&parts));
+                parts
             }
+        };
+        let what = format!("node {} mesh {}", node.index(), mesh.index());
+        let vertices: u64 = parts
+            .iter()
+            .map(|d| d.primitive.positions.len() as u64)
+            .sum();
+        let triangles: u64 = parts.iter().map(|d| d.triangles.len() as u64).sum();
+        src.charge(
+            &what,
+            vertices
+                .saturating_mul(MERGED_BYTES_PER_VERTEX)
+                .saturating_add(triangles.saturating_mul(MERGED_BYTES_PER_TRIANGLE)),
+        )?;
+        let mut primitives = Vec::with_capacity(parts.len());
+        for part in parts.iter() {
             let offset = self.vertex_count as u32;
-            self.vertex_count += prim.positions.len();
+            self.vertex_count += part.primitive.positions.len();
             if u32::try_from(self.vertex_count).is_err() {
                 return Err(src.error(&what, "the scene has 2^32 or more vertices in total"));
             }
-            self.has_normals &= prim.normals.is_some();
-            self.uvs = match (self.uvs.take(), uvs) {
+            self.has_normals &= part.primitive.normals.is_some();
+            self.uvs = match (self.uvs.take(), &part.uvs) {
                 (Some(mut all), Some(uvs)) => {
-                    all.extend(uvs);
+                    all.extend_from_slice(uvs);
                     Some(all)
                 }
                 _ => None,
             };
-            let triangle_count = triangles.len();
             self.triangles
-                .extend(triangles.into_iter().map(|t| t.map(|i| i + offset)));
+                .extend(part.triangles.iter().map(|t| t.map(|i| i + offset)));
             self.primitive_count += 1;
-            primitives.push(Primitive {
-                triangle_count,
-                ..prim
-            });
+            primitives.push(Arc::clone(&part.primitive));
         }
         self.instances.push(Instance {
             node: node.index(),
@@ -233,6 +262,38 @@ impl Rig {
         });
         Ok(())
     }
+}
+
+/// Decodes every primitive of `mesh` once, for all the nodes that instantiate it.
+fn decode_mesh(
+    src: &GltfSource,
+    mesh: &gltf::Mesh<'_>,
+    joint_count: Option<usize>,
+    target_count: usize,
+) -> Result<Vec<Decoded>, MeshIoError> {
+    let mut parts = Vec::new();
+    for primitive in mesh.primitives() {
+        let what = format!("mesh {} primitive {}", mesh.index(), primitive.index());
+        let (prim, triangles, uvs) = read_primitive(src, &primitive, &what, joint_count)?;
+        if prim.morph_positions.len() != target_count {
+            return Err(src.error(
+                &what,
+                format!(
+                    "has {} morph targets, the mesh's first primitive {target_count}",
+                    prim.morph_positions.len()
+                ),
+            ));
+        }
+        parts.push(Decoded {
+            primitive: Arc::new(Primitive {
+                triangle_count: triangles.len(),
+                ..prim
+            }),
+            triangles,
+            uvs,
+        });
+    }
+    Ok(parts)
 }
 
 /// Orders nodes parents first; a node that no root reaches lies on a cycle.
