@@ -13,8 +13,11 @@
 //!    stays in its cell, and [`Player::set_target_cell`] moves to another one at the best
 //!    transition ahead (§3.2.2 "Motion Control").
 //! 3. [`LoopTable`]: the cheapest fixed-length loop of every length (Fig. 3.2, [`loops`]).
-//! 4. [`Reconstructor`]: frames from weights (eq. 3.1), f32, allocation-free; attribute
-//!    vectors R_i have a PCA and an [`AttributeReconstructor`] of their own.
+//! 4. Output frames: [`JumpMap::exact_frame_into`] gives the clip's own frames, bit for bit,
+//!    outside blends and position-space cross-fades inside them ([`exact`]): c is a parameter
+//!    of the analysis, not of the output. [`Reconstructor`] rebuilds frames from weights
+//!    (eq. 3.1, f32, allocation-free) where only weights exist; attribute vectors R_i have a
+//!    PCA and an [`AttributeReconstructor`] of their own.
 //! 5. [`metrics`]: E(c), E*(c) (eqs. 3.12–3.13) and measures of a generated sequence.
 //!
 //! # Deviations from the thesis, and why
@@ -31,6 +34,7 @@
 //!   measures the jump residual ‖Ã_{i+1} − Ã_j‖; see [`player`].
 //! * **P̂** is row-normalised after eq. 3.8 so that it can be sampled.
 
+pub mod exact;
 pub mod graph;
 pub mod loops;
 pub mod metrics;

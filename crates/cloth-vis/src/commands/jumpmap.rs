@@ -316,18 +316,18 @@ pub fn run_jumpmap(
     let stats = anim_pca::jumpmap::metrics::sequence_stats(&map, &generated);
     let offsets = map.root_offsets(&generated.frames);
 
+    // Output frames are the clip's own frames outside blends (bit for bit without root
+    // motion) and position-space cross-fades inside them: c shapes the analysis only.
     let vertices = map.n_vertices();
-    let mut weights = vec![0.0; map.components()];
+    let clip_frames: Vec<&[Vec3]> = std::iter::once(&clip)
+        .chain(&cells)
+        .flat_map(|c| c.frames.iter().map(Vec::as_slice))
+        .collect();
     let mut frames = Vec::with_capacity(request.frames);
     for (frame, offset) in generated.frames.iter().zip(&offsets) {
-        frame.weights_into(&map, &mut weights);
         let mut mesh = vec![Vec3::ZERO; vertices];
-        map.reconstructor()
-            .reconstruct(&weights, &mut mesh)
+        map.exact_frame_into(&clip_frames, frame, *offset, &mut mesh)
             .map_err(|e| anim_error(&request.input, e))?;
-        for v in &mut mesh {
-            *v += *offset;
-        }
         frames.push(mesh);
     }
     if let Some((strip, gpu)) = strip_gpu {
@@ -553,10 +553,12 @@ pub struct JumpmapArgs {
     /// clips that walk across the scene).
     #[arg(long)]
     root_motion: bool,
-    /// c: PCA components of the frames.
+    /// c: PCA components of the frames, for the analysis only (distances D, jump
+    /// probabilities, blend lengths); output frames are the clip's own frames outside blends
+    /// and position-space cross-fades inside them, whatever c.
     #[arg(long, default_value_t = 10)]
     components: usize,
-    /// c*: PCA components of the central velocities.
+    /// c*: PCA components of the central velocities (analysis only, like c).
     #[arg(long, default_value_t = 5)]
     velocity_components: usize,
     /// σ (eq. 3.3), in units of the clip's mean frame-to-frame-pair distance.
