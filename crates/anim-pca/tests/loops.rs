@@ -3,7 +3,7 @@
 
 mod common;
 
-use anim_pca::jumpmap::loops::LOOP_CANDIDATES;
+use anim_pca::jumpmap::loops::{LOOP_CANDIDATES, min_run};
 use anim_pca::{AnimPcaError, Blend, JumpMap, JumpMapParams, LoopTable};
 use common::{assert_close, wave_clip, wave_with_tail};
 
@@ -70,8 +70,9 @@ fn the_period_loops_for_free() {
     }
 }
 
-/// Edges of the loop graph rebuilt from the public API, exactly as the module docs define it.
-fn edges(map: &JumpMap) -> Vec<Vec<(usize, f64)>> {
+/// Edges of the loop graph rebuilt from the public API, exactly as the module docs define it:
+/// (target, cost, natural step?).
+fn edges(map: &JumpMap) -> Vec<Vec<(usize, f64, bool)>> {
     let l = map.n_frames();
     (0..l)
         .map(|i| {
@@ -80,7 +81,7 @@ fn edges(map: &JumpMap) -> Vec<Vec<(usize, f64)>> {
             }
             let mut out = Vec::new();
             if let Some(s) = map.successor(i).filter(|&s| map.core()[s]) {
-                out.push((s, 0.0));
+                out.push((s, 0.0, true));
             }
             let mut jumps: Vec<(f64, usize)> = (0..l)
                 .filter(|&j| map.core()[j] && j != i && j != i + 1 && j + 1 != i)
@@ -90,36 +91,56 @@ fn edges(map: &JumpMap) -> Vec<Vec<(usize, f64)>> {
                 .collect();
             jumps.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
             jumps.truncate(LOOP_CANDIDATES);
-            out.extend(jumps.into_iter().map(|(s, j)| (j, -s.ln())));
+            out.extend(jumps.into_iter().map(|(s, j)| (j, -s.ln(), false)));
             out
         })
         .collect()
 }
 
-/// The cheapest closed walk of each length ≤ max through any start, by exhaustive search.
-fn brute_force(edges: &[Vec<(usize, f64)>], max: usize) -> Vec<f64> {
-    fn walk(
-        edges: &[Vec<(usize, f64)>],
+/// The cheapest acceptable loop of each length ≤ max, by exhaustive search: closed walks from
+/// every start, entered by a jump and closed by a jump back onto it, whose every stretch of
+/// natural play lasts at least R(n) key frames.
+fn brute_force(edges: &[Vec<(usize, f64, bool)>], max: usize) -> Vec<f64> {
+    struct Search<'a> {
+        edges: &'a [Vec<(usize, f64, bool)>],
         start: usize,
-        at: usize,
         len: usize,
-        cost: f64,
-        max: usize,
-        best: &mut [f64],
-    ) {
-        for &(to, c) in &edges[at] {
-            let (nl, nc) = (len + 1, cost + c);
-            if to == start && nc < best[nl] {
-                best[nl] = nc;
-            }
-            if nl < max {
-                walk(edges, start, to, nl, nc, max, best);
+        run: usize,
+        best: f64,
+    }
+    impl Search<'_> {
+        fn walk(&mut self, at: usize, t: usize, run: usize, cost: f64) {
+            for &(to, c, natural) in &self.edges[at] {
+                let (nt, nc) = (t + 1, cost + c);
+                if nt > self.len {
+                    continue;
+                }
+                if natural {
+                    self.walk(to, nt, run + 1, nc);
+                } else if run >= self.run {
+                    if to == self.start && nt == self.len {
+                        self.best = self.best.min(nc);
+                    } else {
+                        self.walk(to, nt, 1, nc);
+                    }
+                }
             }
         }
     }
+    let core = edges.iter().filter(|e| !e.is_empty()).count();
     let mut best = vec![f64::INFINITY; max + 1];
-    for s in 0..edges.len() {
-        walk(edges, s, s, 0, 0.0, max, &mut best);
+    for (len, b) in best.iter_mut().enumerate().skip(2) {
+        for start in 0..edges.len() {
+            let mut search = Search {
+                edges,
+                start,
+                len,
+                run: min_run(len, core, 0),
+                best: f64::INFINITY,
+            };
+            search.walk(start, 0, 1, 0.0);
+            *b = b.min(search.best);
+        }
     }
     best
 }
@@ -127,23 +148,26 @@ fn brute_force(edges: &[Vec<(usize, f64)>], max: usize) -> Vec<f64> {
 #[test]
 fn table_equals_exhaustive_search() {
     // A short aperiodic clip with a tail: many imperfect loops to choose from.
-    let clip = wave_with_tail(4, 9, 5.0, 3);
+    let clip = wave_with_tail(4, 12, 5.0, 3);
     let params = JumpMapParams {
         sigma: 0.3,
         sigma_velocity: 0.3,
         ..JumpMapParams::default()
     };
     let map = JumpMap::analyze(&clip, &params).unwrap();
-    let max = 7;
+    let max = 9;
     let table = LoopTable::build(&map, 0, max, Blend::None).unwrap();
     let best = brute_force(&edges(&map), max);
     for (len, &b) in best.iter().enumerate().skip(2) {
         match table.get(len) {
-            Some(lp) => assert_close(lp.cost, b, 1e-9 * (1.0 + b)),
+            Some(lp) => {
+                assert_close(lp.cost, b, 1e-9 * (1.0 + b));
+                assert!(lp.shortest_run() >= table.min_run(len), "length {len}");
+            }
             None => assert!(b.is_infinite(), "length {len}: brute force found {b}"),
         }
     }
-    assert!(table.iter().count() >= 3);
+    assert!(table.iter().count() >= 3, "{} loops", table.iter().count());
 }
 
 #[test]
@@ -164,4 +188,58 @@ fn bad_parameters_are_named() {
         LoopTable::build(&map, 0, 10, Blend::Smoothness(f64::NAN)),
         Err(AnimPcaError::InvalidParameter { .. })
     ));
+}
+
+/// Every loop of `table` obeys the rule of the module docs: each stretch of natural play lasts
+/// at least R(n) key frames, so the loop shows at least R(n) distinct clip frames.
+fn assert_acceptable(name: &str, table: &LoopTable) -> usize {
+    let mut count = 0;
+    for lp in table.iter() {
+        let r = table.min_run(lp.len());
+        assert!(
+            lp.shortest_run() >= r && lp.distinct_frames() >= r,
+            "{name}: loop of {} frames has a stretch of {} and {} distinct frames (R = {r})",
+            lp.len(),
+            lp.shortest_run(),
+            lp.distinct_frames()
+        );
+        count += 1;
+    }
+    count
+}
+
+#[test]
+fn a_pause_in_the_clip_does_not_become_a_ping_pong() {
+    // A wave that stops for six nearly identical frames halfway: jumps inside the pause are
+    // almost free, so the cheapest closed walk of most lengths bounces there (the chicken's
+    // 6-frame ping-pong). The table must play real stretches of the clip instead.
+    let wave = wave_clip(6, 80, 17.0, 0.0);
+    let clip: Vec<_> = (0..80)
+        .map(|t| {
+            let held = if (40..=46).contains(&t) { 40 } else { t };
+            wave[held]
+                .iter()
+                .map(|p| *p + glam::Vec3::Z * (1e-4 * t as f32))
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    let map = JumpMap::analyze(&clip, &JumpMapParams::default()).unwrap();
+    let table = LoopTable::build(&map, 0, 60, Blend::Fixed(3)).unwrap();
+    let found = assert_acceptable("paused wave", &table);
+    assert!(found > 20, "{found} loop lengths");
+    for n in [24, 34, 48] {
+        let lp = table.get(n).unwrap_or_else(|| panic!("a {n}-frame loop"));
+        // No stretch inside the pause alone: each run reaches beyond its seven frames.
+        assert!(
+            lp.shortest_run() >= n / 4,
+            "{n}: shortest run {}",
+            lp.shortest_run()
+        );
+        let inside = lp
+            .frames
+            .iter()
+            .filter(|f| f.is_key() && (40..=46).contains(&f.from))
+            .count();
+        assert!(inside < n / 2, "{n}: {inside} of its frames are the pause");
+    }
 }

@@ -106,3 +106,64 @@ fn chicken_crossing_with_root_motion_extracted() {
     );
     assert!(stats.transitions > 0);
 }
+
+/// The loop table on every real clip and the synthetic drape (issue #19): every loop obeys
+/// the no-oscillation rule, and the table of lengths 2 … 96 is printed for the note (length:
+/// jumps, distinct frames, shortest stretch, cost).
+#[test]
+fn loops_of_the_real_clips_never_oscillate() {
+    use anim_pca::{Blend, LoopTable};
+    let drape = synth::simulate_cloth(&synth::ClothParams {
+        grid: 20,
+        frames: 90,
+        ..Default::default()
+    })
+    .unwrap()
+    .frames;
+    let mut clips = vec![("synthetic drape".to_owned(), drape)];
+    for rel in [
+        "anim/chickenCrossing",
+        "anim/horse-gallop",
+        "anim/gltf/BrainStem.glb",
+    ] {
+        if let Some(frames) = load(rel) {
+            clips.push((rel.to_owned(), frames));
+        }
+    }
+    for (name, frames) in &clips {
+        let map = JumpMap::analyze(frames, &JumpMapParams::default()).unwrap();
+        let t = Instant::now();
+        let table = LoopTable::build(&map, 0, 96, Blend::Fixed(3)).unwrap();
+        let built = t.elapsed().as_secs_f64();
+        let mut lines = Vec::new();
+        for n in [12, 24, 30, 48, 60, 96] {
+            lines.push(match table.get(n) {
+                Some(lp) => format!(
+                    "{n}: {} jumps, {} distinct, run ≥ {}, cost {:.2}",
+                    lp.transitions.len(),
+                    lp.distinct_frames(),
+                    lp.shortest_run(),
+                    lp.cost
+                ),
+                None => format!("{n}: none"),
+            });
+        }
+        println!(
+            "{name} ({} frames, core {}): table 2..=96 in {built:.2} s; {}",
+            frames.len(),
+            table.core_frames(),
+            lines.join("; ")
+        );
+        for lp in table.iter() {
+            let r = table.min_run(lp.len());
+            assert!(
+                lp.shortest_run() >= r && lp.distinct_frames() >= r,
+                "{name}: {} frames, stretch {}, {} distinct, R = {r}",
+                lp.len(),
+                lp.shortest_run(),
+                lp.distinct_frames()
+            );
+        }
+        assert!(table.iter().count() > 0, "{name}: no loop at all");
+    }
+}

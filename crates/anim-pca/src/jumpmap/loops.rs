@@ -10,20 +10,42 @@
 //! eq. 3.9/3.11 for that jump). The loop table holds, for every length up to a maximum, the
 //! cheapest such loop.
 //!
+//! # Acceptable loops: no oscillation over a handful of frames
+//! The cheapest closed walk of a length is not always one a user would accept: on a clip
+//! without a good long loop it can be a few frames played back and forth (the chicken's
+//! `--loop 48` was a 6-frame ping-pong, 36 → 37 → 38 → blend → 36, eight times over). A loop
+//! of n frames is therefore required to play every stretch of natural playback between two
+//! jumps for at least
+//!
+//! R(n) = max(min(⌈n/4⌉, ⌈core/4⌉), b + 1) key frames ([`min_run`]),
+//!
+//! core being the cell's core frame count and b the longest blend among the candidate jumps.
+//! Such a loop shows at least R distinct clip frames, repeats at most four times within its
+//! period, and can never oscillate: each jump is followed by a quarter of the loop (or of the
+//! clip) of ordinary play, and by more clip frames than cross-fade frames — with b = 3, a
+//! 12-frame "loop" of three frames, three blends, three frames, three blends is a stutter,
+//! not a loop, and is refused. The table holds, for every length, the
+//! cheapest loop that obeys the rule, or none; [`Loop::distinct_frames`] and
+//! [`Loop::shortest_run`] report what a loop shows.
+//!
 //! # Method, and how it differs from video textures
 //! Schödl et al. build loops from "primitive loops" (one backward jump each) with a dynamic
-//! program over lengths and transitions. Here the search is a plain shortest-path dynamic
-//! program over (length, frame) from every start frame: cost_t(v) = min over edges u → v of
-//! cost_{t − len(u,v)}(u) + cost(u, v). It is exact over the candidate edges — every natural
-//! step and, per frame, the [`LOOP_CANDIDATES`] jumps of highest score — and needs no special
-//! structure: forward jumps (i → j > i + 1) are allowed as well, and blends make a jump's
-//! length part of the search, so a table entry of length n really plays n frames. Loops stay
-//! inside one cell and inside its core (see [`graph`](super::graph)). A jump to i itself (a
-//! frozen frame) or to i − 1 (back-and-forth) is never a candidate, as with the player's
-//! memory.
+//! program over lengths and transitions. Here the search is a shortest-path dynamic program
+//! over (length, frame, phase) from every start: *landed* at frame v at time t (a jump, or
+//! the start, put v on screen), and *free* at v (the current run has lasted ≥ R frames, so v
+//! may jump). free_t(v) = min(landed_{t−R+1}(v − R + 1) when v − R + 1 … v is natural play,
+//! free_{t−1}(v − 1)); landed_{t+len}(w) = min over jumps v → w of free_t(v) + cost(v, w).
+//! It is exact over the candidate edges — every natural step and, per frame, the
+//! [`LOOP_CANDIDATES`] jumps of highest score — and needs no special structure: forward jumps
+//! (i → j > i + 1) are allowed as well, and blends make a jump's length part of the search,
+//! so a table entry of length n really plays n frames. A loop starts where a jump lands, at
+//! its lowest landing frame, so each is found once. R depends on n, so lengths with the same
+//! R share one run of the program. Loops stay inside one cell and inside its core (see
+//! [`graph`](super::graph)). A jump to i itself (a frozen frame) or to i − 1 (back-and-forth)
+//! is never a candidate, as with the player's memory.
 //!
-//! Cost: O(starts · n_max · frames · (K + 1)) relaxations; for the 48-frame horse gallop and
-//! n_max = 200 that is a few milliseconds; starts run in parallel.
+//! Cost: O(groups · starts · n_max · frames · (K + 2)) relaxations, with about n_max / 4
+//! groups up to the clip's quarter; starts run in parallel.
 
 use rayon::prelude::*;
 
@@ -57,6 +79,35 @@ impl Loop {
     /// Length n of one period in generated frames.
     pub fn len(&self) -> usize {
         self.frames.len()
+    }
+
+    /// Distinct clip frames the loop's key frames show.
+    pub fn distinct_frames(&self) -> usize {
+        let mut keys: Vec<usize> = self
+            .frames
+            .iter()
+            .filter(|f| f.is_key())
+            .map(|f| f.from)
+            .collect();
+        keys.sort_unstable();
+        keys.dedup();
+        keys.len()
+    }
+
+    /// Key frames of the shortest stretch of natural play between two jumps (at least
+    /// [`min_run`] of the loop's length; see the [module docs](self)).
+    pub fn shortest_run(&self) -> usize {
+        let n = self.frames.len();
+        let t = &self.transitions;
+        (0..t.len())
+            .map(|k| {
+                // From the landing of jump k − 1 to the source of jump k, cyclically.
+                let prev = &t[(k + t.len() - 1) % t.len()];
+                let landing = (prev.index + prev.blend_frames + 1) % n;
+                (t[k].index + n - landing) % n + 1
+            })
+            .min()
+            .unwrap_or(n)
     }
 
     /// Whether the loop is empty (never, for a loop from [`LoopTable`]).
@@ -93,6 +144,10 @@ impl Loop {
 #[derive(Clone, Debug)]
 pub struct LoopTable {
     cell: usize,
+    /// Core frames of the cell (R(n) is capped at a quarter of them).
+    core_frames: usize,
+    /// Longest blend among the candidate jumps (R(n) > it).
+    blend_max: usize,
     loops: Vec<Option<Loop>>,
 }
 
@@ -155,6 +210,7 @@ impl LoopTable {
             if let Some(s) = map.successor(i).filter(|&s| map.core()[s]) {
                 out.push(Edge {
                     to: s,
+                    natural: true,
                     len: 1,
                     cost: 0.0,
                 });
@@ -176,34 +232,70 @@ impl LoopTable {
             for (score, j) in jumps {
                 out.push(Edge {
                     to: j,
+                    natural: false,
                     len: 1 + blend_frames(map, blend, i, j),
                     cost: -score.ln(),
                 });
             }
         }
 
-        // Best closed walk of each length through each start; the start is the walk's lowest
-        // frame, so every loop is found exactly once (from its lowest frame).
-        let per_start: Vec<Vec<Option<Walk>>> = core
-            .par_iter()
-            .map(|&s| closed_walks(&edges, range.start, s, max_len))
-            .collect();
+        // Lengths that share R(n) share one run of the program, up to their longest.
+        let blend_max = edges
+            .iter()
+            .flatten()
+            .filter(|e| !e.natural)
+            .map(|e| e.len - 1)
+            .max()
+            .unwrap_or(0);
         let mut loops: Vec<Option<Loop>> = vec![None; max_len + 1];
-        for walks in per_start {
-            for (len, walk) in walks.into_iter().enumerate() {
-                let Some((cost, keys)) = walk else { continue };
-                let better = loops[len].as_ref().is_none_or(|l| cost < l.cost);
-                if better {
-                    loops[len] = Some(realise(map, blend, &keys, cost));
+        let mut len = 2;
+        while len <= max_len {
+            let run = min_run(len, core.len(), blend_max);
+            let mut last = len;
+            while last < max_len && min_run(last + 1, core.len(), blend_max) == run {
+                last += 1;
+            }
+            let program = Program {
+                edges: &edges,
+                first: range.start,
+                run,
+                max_len: last,
+            };
+            let per_start: Vec<Vec<Option<Walk>>> =
+                core.par_iter().map(|&s| program.closed_walks(s)).collect();
+            for walks in per_start {
+                for (n, walk) in walks.into_iter().enumerate().skip(len) {
+                    let Some((cost, keys)) = walk else { continue };
+                    let better = loops[n].as_ref().is_none_or(|l| cost < l.cost);
+                    if better {
+                        loops[n] = Some(realise(map, blend, &keys, cost));
+                    }
                 }
             }
+            len = last + 1;
         }
-        Ok(Self { cell, loops })
+        Ok(Self {
+            cell,
+            core_frames: core.len(),
+            blend_max,
+            loops,
+        })
     }
 
     /// The cell the loops play in.
     pub fn cell(&self) -> usize {
         self.cell
+    }
+
+    /// Core frames of the cell.
+    pub fn core_frames(&self) -> usize {
+        self.core_frames
+    }
+
+    /// R(n): the shortest stretch of natural play its loop of `len` frames may have
+    /// ([`min_run`] with this cell's core and longest candidate blend).
+    pub fn min_run(&self, len: usize) -> usize {
+        min_run(len, self.core_frames, self.blend_max)
     }
 
     /// Longest length the table was built for.
@@ -228,62 +320,131 @@ type Walk = (f64, Vec<usize>);
 #[derive(Clone, Copy, Debug)]
 struct Edge {
     to: usize,
+    /// The natural step i → i + 1 (cost 0, one frame); every other edge is a jump.
+    natural: bool,
     len: usize,
     cost: f64,
 }
 
-/// For each length t ≤ `max_len`, the cheapest closed walk s → … → s of t frames that never
-/// visits a frame below s, as (cost, key frames from s, without the final s).
-fn closed_walks(edges: &[Vec<Edge>], first: usize, s: usize, max_len: usize) -> Vec<Option<Walk>> {
-    let n = edges.len();
-    let ls = s - first;
-    let mut cost = vec![f64::INFINITY; (max_len + 1) * n];
-    let mut pred = vec![u32::MAX; (max_len + 1) * n]; // predecessor frame (local)
-    cost[ls] = 0.0;
-    for t in 0..max_len {
-        for v in ls..n {
-            let c = cost[t * n + v];
-            if !c.is_finite() {
-                continue;
+/// The shortest stretch of natural play a loop of `len` frames may have between two jumps,
+/// in a cell of `core` core frames with blends of at most `blend` frames:
+/// R(n) = max(min(⌈n/4⌉, ⌈core/4⌉), b + 1) (see the [module docs](self)).
+pub fn min_run(len: usize, core: usize, blend: usize) -> usize {
+    len.div_ceil(4).min(core.div_ceil(4)).max(blend + 1)
+}
+
+/// The dynamic program of the [module docs](self) for one run length R, lengths ≤ `max_len`.
+struct Program<'a> {
+    edges: &'a [Vec<Edge>],
+    first: usize,
+    run: usize,
+    max_len: usize,
+}
+
+/// Where a state's cost came from, for walking a loop back.
+#[derive(Clone, Copy)]
+enum From {
+    None,
+    /// Landed by a jump from the free state (time, frame).
+    Jump(u32, u32),
+    /// Free after R frames of natural play from a landing R − 1 frames earlier.
+    Landing,
+    /// Free, one natural step on from the free state one frame earlier.
+    Step,
+}
+
+impl Program<'_> {
+    /// For each length t ≤ `max_len`, the cheapest loop that starts where a jump lands at `s`
+    /// and lands nowhere below it, as (cost, key frames from s).
+    fn closed_walks(&self, s: usize) -> Vec<Option<Walk>> {
+        let (edges, first, r, max_len) = (self.edges, self.first, self.run, self.max_len);
+        let n = edges.len();
+        let ls = s - first;
+        // natural[v]: key frames of natural play ending at v (1 where v is not reached by a
+        // natural step from a core frame).
+        let mut natural = vec![1usize; n];
+        for v in 1..n {
+            if edges[v - 1].iter().any(|e| e.natural) {
+                natural[v] = natural[v - 1] + 1;
             }
-            for e in &edges[v] {
-                let w = e.to - first;
-                let tt = t + e.len;
-                if w < ls || tt > max_len {
+        }
+        let size = (max_len + 1) * n;
+        let mut landed = vec![f64::INFINITY; size];
+        let mut free = vec![f64::INFINITY; size];
+        let mut landed_from = vec![From::None; size];
+        let mut free_from = vec![From::None; size];
+        landed[ls] = 0.0;
+        for t in 0..=max_len {
+            for v in ls..n {
+                let at = t * n + v;
+                // Free at (t, v): R frames of play from a landing, or one more step.
+                if natural[v] >= r && t + 1 >= r {
+                    let from = (t + 1 - r) * n + v + 1 - r;
+                    if v + 1 - r >= ls && landed[from] < free[at] {
+                        free[at] = landed[from];
+                        free_from[at] = From::Landing;
+                    }
+                }
+                if t > 0 && v > ls && natural[v] >= 2 {
+                    let from = (t - 1) * n + v - 1;
+                    if free[from] < free[at] {
+                        free[at] = free[from];
+                        free_from[at] = From::Step;
+                    }
+                }
+                let c = free[at];
+                if !c.is_finite() {
                     continue;
                 }
-                let nc = c + e.cost;
-                if nc < cost[tt * n + w] {
-                    cost[tt * n + w] = nc;
-                    pred[tt * n + w] = v as u32;
+                for e in edges[v].iter().filter(|e| !e.natural) {
+                    let w = e.to - first;
+                    let tt = t + e.len;
+                    if w < ls || tt > max_len {
+                        continue;
+                    }
+                    let to = tt * n + w;
+                    if c + e.cost < landed[to] {
+                        landed[to] = c + e.cost;
+                        landed_from[to] = From::Jump(t as u32, v as u32);
+                    }
                 }
             }
         }
+        (0..=max_len)
+            .map(|t| {
+                if t < 2 || !landed[t * n + ls].is_finite() {
+                    return None;
+                }
+                // Walk back from landing at (t, s) to the start: runs of key frames, reversed.
+                let mut keys = Vec::new();
+                let (mut tt, mut v) = (t, ls);
+                // Until (0, s), the start, which no jump reached.
+                while let From::Jump(jt, jv) = landed_from[tt * n + v] {
+                    let (mut ft, mut fv) = (jt as usize, jv as usize);
+                    loop {
+                        keys.push(fv + first);
+                        match free_from[ft * n + fv] {
+                            From::Step => {
+                                ft -= 1;
+                                fv -= 1;
+                            }
+                            _ => {
+                                // From::Landing: the run's remaining R − 1 frames down to it.
+                                for k in 1..r {
+                                    keys.push(fv - k + first);
+                                }
+                                tt = ft + 1 - r;
+                                v = fv + 1 - r;
+                                break;
+                            }
+                        }
+                    }
+                }
+                keys.reverse();
+                Some((landed[t * n + ls], keys))
+            })
+            .collect()
     }
-    let len_of = |u: usize, v: usize| {
-        edges[u]
-            .iter()
-            .find(|e| e.to - first == v)
-            .map_or(1, |e| e.len)
-    };
-    (0..=max_len)
-        .map(|t| {
-            if t < 2 || !cost[t * n + ls].is_finite() {
-                return None;
-            }
-            // Walk the predecessors back from (t, s) to (0, s).
-            let mut keys = Vec::new();
-            let (mut tt, mut v) = (t, ls);
-            while tt > 0 {
-                let u = pred[tt * n + v] as usize;
-                tt -= len_of(u, v);
-                keys.push(u + first);
-                v = u;
-            }
-            keys.reverse();
-            Some((cost[t * n + ls], keys))
-        })
-        .collect()
 }
 
 /// The generated frames and jumps of a loop through `keys` (closing back to `keys[0]`).

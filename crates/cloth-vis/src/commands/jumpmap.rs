@@ -93,6 +93,57 @@ pub struct JumpMapSummary {
     pub components: (usize, usize),
     /// Statistics of the generated run.
     pub stats: anim_pca::jumpmap::metrics::SequenceStats,
+    /// The loop played, for `--loop N`.
+    pub loop_info: Option<LoopInfo>,
+}
+
+/// What a `--loop N` run played: one period of the cheapest acceptable loop
+/// ([`anim_pca::jumpmap::loops`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoopInfo {
+    /// N: generated frames per period, blend frames included.
+    pub length: usize,
+    /// Jumps per period.
+    pub jumps: usize,
+    /// Distinct clip frames the period shows.
+    pub distinct_frames: usize,
+    /// Key frames of its shortest stretch of natural play between two jumps.
+    pub shortest_run: usize,
+    /// Σ −ln s_ij over its jumps.
+    pub cost: f64,
+}
+
+/// The refusal of `--loop n` when the clip has no acceptable loop of that length, naming the
+/// nearest lengths below and above that have one.
+fn no_loop_message(table: &LoopTable, n: usize) -> String {
+    let below: Vec<String> = (2..n)
+        .rev()
+        .filter(|&m| table.get(m).is_some())
+        .take(3)
+        .map(|m| m.to_string())
+        .collect();
+    let above: Vec<String> = (n + 1..=table.max_len())
+        .filter(|&m| table.get(m).is_some())
+        .take(3)
+        .map(|m| m.to_string())
+        .collect();
+    let list = |v: &[String]| {
+        if v.is_empty() {
+            "none".to_owned()
+        } else {
+            v.join(", ")
+        }
+    };
+    format!(
+        "--loop {n}: the clip has no acceptable loop of exactly {n} frames (one whose every \
+         stretch of natural play between jumps lasts at least {} key frames, so that it does \
+         not oscillate over a handful of frames); nearest lengths that have one: below {}, \
+         above (up to {}) {}",
+        table.min_run(n),
+        list(&below),
+        table.max_len(),
+        list(&above)
+    )
 }
 
 impl JumpMapSummary {
@@ -112,7 +163,13 @@ impl JumpMapSummary {
             100.0 * s.coverage,
             s.mean_jump_distance,
             s.max_jump_distance
-        )
+        ) + &self.loop_info.map_or(String::new(), |l| {
+            format!(
+                "\nloop: {} frames per period, {} jump(s), {} distinct clip frames, shortest \
+                 stretch of natural play {} key frames, cost {:.3}",
+                l.length, l.jumps, l.distinct_frames, l.shortest_run, l.cost
+            )
+        })
     }
 }
 
@@ -265,31 +322,24 @@ pub fn run_jumpmap(
     }
     let map = JumpMap::analyze_cells(&clips, &request.params)
         .map_err(|e| anim_error(&request.input, e))?;
+    let mut loop_info = None;
     let generated = match control.loop_length {
         Some(n) => {
             let cell = map.cell_of(request.playback.start_frame.min(map.n_frames() - 1));
-            let table = LoopTable::build(&map, cell, n, request.playback.blend)
+            // A quarter beyond n, for the nearest lengths to offer when n has no loop.
+            let reach = (n + n / 4 + 2).min(anim_pca::jumpmap::loops::MAX_LOOP_LENGTH);
+            let table = LoopTable::build(&map, cell, reach, request.playback.blend)
                 .map_err(|e| anim_error(&request.input, e))?;
             let Some(found) = table.get(n) else {
-                let near: Vec<String> = table
-                    .iter()
-                    .map(|l| l.len())
-                    .filter(|&m| m + 10 >= n)
-                    .map(|m| m.to_string())
-                    .collect();
-                return Err(invalid(
-                    &request.input,
-                    format!(
-                        "--loop {n}: the clip has no loop of exactly {n} frames; nearest \
-                         lengths below: {}",
-                        if near.is_empty() {
-                            "none".to_owned()
-                        } else {
-                            near.join(", ")
-                        }
-                    ),
-                ));
+                return Err(invalid(&request.input, no_loop_message(&table, n)));
             };
+            loop_info = Some(LoopInfo {
+                length: n,
+                jumps: found.transitions.len(),
+                distinct_frames: found.distinct_frames(),
+                shortest_run: found.shortest_run(),
+                cost: found.cost,
+            });
             found.play(request.frames)
         }
         None => {
@@ -385,6 +435,7 @@ pub fn run_jumpmap(
         vertices,
         components: (map.components(), map.velocity_components()),
         stats,
+        loop_info,
     })
 }
 

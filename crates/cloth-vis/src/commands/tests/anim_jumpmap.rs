@@ -334,10 +334,40 @@ fn loop_output_repeats_with_the_requested_period() {
     for t in 0..100 - 24 {
         assert_eq!(frame(t), frame(t + 24), "frame {t}");
     }
-    // A length with no loop is refused, naming the lengths that exist.
-    req.control.loop_length = Some(1);
+    // The loop is reported, obeys the no-oscillation rule, and its key frames are the clip's.
+    let info = summary.loop_info.expect("a --loop run reports its loop");
+    assert_eq!(info.length, 24);
+    assert!(
+        info.shortest_run >= 6 && info.distinct_frames >= 6,
+        "{info:?}"
+    );
+    let (clip, _) = meshio::load_animation(
+        &dir.path().join("clip"),
+        &meshio::AnimationOptions::default(),
+    )
+    .unwrap();
+    let exact = (0..24)
+        .filter(|&t| {
+            clip.frames.iter().any(|f| {
+                f.iter()
+                    .flat_map(|v| v.to_array())
+                    .zip(frame(t))
+                    .all(|(a, b)| a.to_bits() == b.to_bits())
+            })
+        })
+        .count();
+    assert!(
+        exact >= 24 - 3 * info.jumps,
+        "{exact} of 24 frames are clip frames"
+    );
+    // A length with no acceptable loop is refused, naming the nearest lengths that have one.
+    req.control.loop_length = Some(5);
     let err = run_jumpmap(&req, None).unwrap_err().to_string();
-    assert!(err.contains("max_len"), "{err}");
+    assert!(err.contains("no acceptable loop of exactly 5"), "{err}");
+    assert!(
+        err.contains("above (up to 8)") && err.contains("below"),
+        "{err}"
+    );
 }
 
 #[test]
