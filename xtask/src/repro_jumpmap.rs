@@ -108,6 +108,70 @@ struct Measured {
     playback_fps: f64,
     sweep: Vec<SweepRow>,
     strip: Option<String>,
+    /// The loop table 2 ..= max(LOOP_LENGTHS) with b = 3: build seconds, the cell's core
+    /// frames, and per length (length, R(n), the loop if any).
+    loops: (f64, usize, Vec<LoopRow>),
+}
+
+/// A row of the loop-quality table: N, R(N) and the loop, if N has an acceptable one.
+type LoopRow = (usize, usize, Option<anim_pca::Loop>);
+
+/// Lengths of the loop-quality table (`--loop N`).
+const LOOP_LENGTHS: [usize; 7] = [12, 24, 30, 48, 60, 96, 120];
+
+/// The loop table of cell 0 with the defaults and b = 3, and the rows of the report.
+fn loop_rows(map: &JumpMap) -> anyhow::Result<(f64, usize, Vec<LoopRow>)> {
+    let start = Instant::now();
+    let max = LOOP_LENGTHS[LOOP_LENGTHS.len() - 1];
+    let table = anim_pca::LoopTable::build(map, 0, max, Blend::Fixed(BLEND_FRAMES))?;
+    let built = start.elapsed().as_secs_f64();
+    let rows = LOOP_LENGTHS
+        .iter()
+        .map(|&n| (n, table.min_run(n), table.get(n).cloned()))
+        .collect();
+    Ok((built, table.core_frames(), rows))
+}
+
+fn loop_table(md: &mut String, results: &[(&Sequence, Measured)]) {
+    let _ = writeln!(md, "## Loops: `--loop N`\n");
+    let _ = writeln!(
+        md,
+        "The cheapest acceptable loop of each length N (`LoopTable`, b = {BLEND_FRAMES}, cell 0): \
+         every stretch of natural play between two jumps lasts at least R(N) = \
+         max(min(⌈N/4⌉, ⌈core/4⌉), b + 1, min(8, ⌈core/2⌉)) key frames, so no loop oscillates \
+         over a handful of frames. *exact*: generated frames of one period that are the clip's \
+         own frames bit for bit (the others are cross-fades); *cost*: Σ −ln s_ij over its jumps \
+         (0: perfect jumps). The table of every length 2 … {} is built once per clip.\n",
+        LOOP_LENGTHS[LOOP_LENGTHS.len() - 1]
+    );
+    let _ = writeln!(
+        md,
+        "| sequence | core | table (s) | N | R(N) | jumps | distinct frames | shortest stretch | exact | cost |"
+    );
+    let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for (s, m) in results {
+        let (built, core, rows) = &m.loops;
+        for (n, r, lp) in rows {
+            let _ = match lp {
+                Some(lp) => writeln!(
+                    md,
+                    "| {} | {core} | {built:.2} | {n} | {r} | {} | {} | {} | {} | {:.2} |",
+                    s.name,
+                    lp.transitions.len(),
+                    lp.distinct_frames(),
+                    lp.shortest_run(),
+                    lp.frames.iter().filter(|f| f.is_key()).count(),
+                    lp.cost
+                ),
+                None => writeln!(
+                    md,
+                    "| {} | {core} | {built:.2} | {n} | {r} | none: no acceptable loop of this length | | | | |",
+                    s.name
+                ),
+            };
+        }
+    }
+    let _ = writeln!(md);
 }
 
 fn median(mut xs: Vec<f64>) -> f64 {
@@ -290,6 +354,7 @@ fn measure(
         playback_fps,
         sweep,
         strip,
+        loops: loop_rows(&map)?,
     })
 }
 
@@ -612,6 +677,8 @@ fn report(
          skeleton, too low or too high unstable; one criterion alone (q = 1 or q* = 1) finds \
          good transitions in the first 100–140 frames, both together need the whole clip.\n"
     );
+
+    loop_table(&mut md, results);
 
     let _ = writeln!(md, "## Strips\n");
     match gpu {

@@ -17,14 +17,16 @@
 //! of n frames is therefore required to play every stretch of natural playback between two
 //! jumps for at least
 //!
-//! R(n) = max(min(⌈n/4⌉, ⌈core/4⌉), b + 1) key frames ([`min_run`]),
+//! R(n) = max(min(⌈n/4⌉, ⌈core/4⌉), b + 1, min(8, ⌈core/2⌉)) key frames ([`min_run`]),
 //!
 //! core being the cell's core frame count and b the longest blend among the candidate jumps.
 //! Such a loop shows at least R distinct clip frames, repeats at most four times within its
 //! period, and can never oscillate: each jump is followed by a quarter of the loop (or of the
-//! clip) of ordinary play, and by more clip frames than cross-fade frames — with b = 3, a
-//! 12-frame "loop" of three frames, three blends, three frames, three blends is a stutter,
-//! not a loop, and is refused. The table holds, for every length, the
+//! clip) of ordinary play; by more clip frames than cross-fade frames (with b = 3, a 12-frame
+//! "loop" of three frames, three blends, three frames, three blends is a stutter); and by at
+//! least [`MIN_STRETCH`] = 8 frames, a quarter second at 30 fps, however short the loop or
+//! small the core (a core of fewer than 16 frames: half of it). CesiumMan's walk, whose core
+//! is 14 frames, otherwise loops 4 frames between blends. The table holds, for every length, the
 //! cheapest loop that obeys the rule, or none; [`Loop::distinct_frames`] and
 //! [`Loop::shortest_run`] report what a loop shows.
 //!
@@ -328,10 +330,18 @@ struct Edge {
 
 /// The shortest stretch of natural play a loop of `len` frames may have between two jumps,
 /// in a cell of `core` core frames with blends of at most `blend` frames:
-/// R(n) = max(min(⌈n/4⌉, ⌈core/4⌉), b + 1) (see the [module docs](self)).
+/// R(n) = max(min(⌈n/4⌉, ⌈core/4⌉), b + 1, min([`MIN_STRETCH`], ⌈core/2⌉)) (see the
+/// [module docs](self)).
 pub fn min_run(len: usize, core: usize, blend: usize) -> usize {
-    len.div_ceil(4).min(core.div_ceil(4)).max(blend + 1)
+    len.div_ceil(4)
+        .min(core.div_ceil(4))
+        .max(blend + 1)
+        .max(MIN_STRETCH.min(core.div_ceil(2)))
 }
+
+/// The fewest key frames of natural play between two jumps of any loop (a quarter second at
+/// 30 fps), unless the cell's core has fewer than twice as many.
+pub const MIN_STRETCH: usize = 8;
 
 /// The dynamic program of the [module docs](self) for one run length R, lengths ≤ `max_len`.
 struct Program<'a> {

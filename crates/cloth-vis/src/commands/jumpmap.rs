@@ -111,6 +111,8 @@ pub struct LoopInfo {
     pub shortest_run: usize,
     /// Σ −ln s_ij over its jumps.
     pub cost: f64,
+    /// Core frames of the cell (frames the pruned jump map can always return to).
+    pub core_frames: usize,
 }
 
 /// The refusal of `--loop n` when the clip has no acceptable loop of that length, naming the
@@ -168,7 +170,16 @@ impl JumpMapSummary {
                 "\nloop: {} frames per period, {} jump(s), {} distinct clip frames, shortest \
                  stretch of natural play {} key frames, cost {:.3}",
                 l.length, l.jumps, l.distinct_frames, l.shortest_run, l.cost
-            )
+            ) + &if l.core_frames < 2 * anim_pca::jumpmap::loops::MIN_STRETCH {
+                format!(
+                    "\nwarning: the clip's core, the frames its jump map can always return to, \
+                     is only {} frames, so every loop plays stretches this short; a larger \
+                     --sigma or --q widens it",
+                    l.core_frames
+                )
+            } else {
+                String::new()
+            }
         })
     }
 }
@@ -339,6 +350,7 @@ pub fn run_jumpmap(
                 distinct_frames: found.distinct_frames(),
                 shortest_run: found.shortest_run(),
                 cost: found.cost,
+                core_frames: table.core_frames(),
             });
             found.play(request.frames)
         }
