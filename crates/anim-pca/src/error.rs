@@ -174,3 +174,16 @@ pub(crate) fn invalid(
         reason,
     }
 }
+
+/// An [`AnimPcaError::InvalidFile`]: `field` of a container holds `value`, which breaks `reason`.
+pub(crate) fn bad_file(
+    field: &'static str,
+    value: impl std::fmt::Display,
+    reason: &'static str,
+) -> AnimPcaError {
+    AnimPcaError::InvalidFile {
+        field,
+        value: value.to_string(),
+        reason,
+    }
+}

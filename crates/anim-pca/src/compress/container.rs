@@ -346,6 +346,6 @@ fn coded_triangles(triangles: &[[u32; 3]], v: usize) -> Result<Vec<[u32; 3]>> {
         .chunks_exact(3)
         .map(|t| [t[0], t[1], t[2]])
         .collect();
-    let bytes = super::format::encode_triangles(&ordered, v);
-    super::format::decode_triangles(&bytes, ordered.len(), v)
+    let bytes = super::connectivity::encode_triangles(&ordered, v);
+    super::connectivity::decode_triangles(&bytes, ordered.len(), v)
 }

@@ -71,6 +71,7 @@
 //! assert!(bpvf_from_file(bytes.len(), 64, 40) < 32.0);
 //! ```
 
+mod connectivity;
 mod container;
 mod decode;
 pub mod format;
