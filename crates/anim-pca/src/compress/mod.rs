@@ -16,7 +16,9 @@
 //! 6. [`Decoder`] rebuilds any frame on its own (Fig. 3.18 on the CPU), into a caller buffer;
 //!    with the `gpu` feature (on by default), `GpuDecoder` does the same in a WGSL compute
 //!    shader, into a storage buffer that a renderer binds as its vertex buffer.
-//! 7. [`search_clusters`] raises k from 1 until a target d_a or file rate is met (§3.3.2).
+//! 7. [`search_clusters`] raises k from 1 until a target d_a or file rate is met (§3.3.2);
+//!    [`choose_bits`] picks the fewest q_c, q_w bits that cost at most 1 % of the
+//!    unquantized d_a (`anim compress`'s default).
 //! 8. [`distortion`] gives d_a and d_f ("Error Measurement"); [`RateParams`] gives
 //!    eqs. 3.16–3.18 and [`bpvf_from_file`] the rate of the actual file.
 //!
@@ -71,6 +73,7 @@
 //! assert!(bpvf_from_file(bytes.len(), 64, 40) < 32.0);
 //! ```
 
+mod bits;
 mod connectivity;
 mod container;
 mod decode;
@@ -82,6 +85,7 @@ mod model;
 mod quantize;
 mod search;
 
+pub use bits::{BitsChoice, DA_FLOOR, DEFAULT_BITS_TOLERANCE, choose_bits};
 pub use container::{Compressed, TimeBasis};
 pub use decode::{DecodeScratch, Decoder};
 pub use format::crc32;

@@ -18,8 +18,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anim_pca::compress::{
-    Compressed, CpcaParams, Decoder, Distortion, RateParams, RateTarget, SearchStep,
-    bpvf_from_file, search_clusters,
+    Compressed, CpcaModel, CpcaParams, DEFAULT_BITS_TOLERANCE, Decoder, Distortion, RateParams,
+    RateTarget, SearchStep, bpvf_from_file, choose_bits, search_clusters,
 };
 use glam::Vec3;
 
@@ -38,8 +38,22 @@ pub struct CompressRequest {
     pub target: Option<RateTarget>,
     /// Largest k the search tries.
     pub k_max: usize,
+    /// Choose q_c and/or q_w ([`choose_bits`]) instead of taking them from `params`: the
+    /// fewest bits that add at most [`DEFAULT_BITS_TOLERANCE`] to the unquantized d_a. Only
+    /// without a target.
+    pub auto_bits: AutoBits,
     /// The `.cpca` file to write.
     pub out: PathBuf,
+}
+
+/// Which quantization bit counts `compress` chooses itself (those not given on the command
+/// line).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AutoBits {
+    /// Choose q_c.
+    pub components: bool,
+    /// Choose q_w.
+    pub weights: bool,
 }
 
 /// Largest k `--target-da`/`--target-bpvf` tries unless told (`--k-max`).
@@ -65,6 +79,8 @@ pub struct CompressSummary {
     pub encode_seconds: f64,
     /// With a target: every k tried, and whether the chosen one meets the target.
     pub search: Option<(Vec<SearchStep>, bool)>,
+    /// With chosen bits: d_a of the unquantized model (32-bit codes) and the encodings tried.
+    pub bits: Option<(f64, usize)>,
 }
 
 impl CompressSummary {
@@ -87,10 +103,23 @@ impl CompressSummary {
                 steps.len()
             ),
         };
+        let bits = match self.bits {
+            None => String::new(),
+            Some((d0, tried)) => format!(
+                "\nbits: q_c = {}, q_w = {} chosen ({tried} encodings): quantization adds {:.1e} \
+                 to the unquantized d_a {d0:.4} (allowed: {:.0} % of it, or {:.0e} if more; \
+                 --qc/--qw fix them)",
+                r.bits_components,
+                r.bits_weights,
+                self.distortion.da - d0,
+                100.0 * DEFAULT_BITS_TOLERANCE,
+                anim_pca::compress::DA_FLOOR
+            ),
+        };
         format!(
             "compress: V = {}, F = {}, {} triangles, k = {}, c = {}, c* = {}, q_c = {}, q_w = {}: \
              {} bytes, {:.3} bpvf (file), d_a = {:.4}, worst d_f = {:.4e} (frame {}), \
-             encoded in {:.2} s{}",
+             encoded in {:.2} s{}{bits}",
             self.vertices,
             self.frames,
             self.triangles,
@@ -291,7 +320,19 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
     let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
     let start = Instant::now();
-    let (packed, search) = match request.target {
+    let auto = request.auto_bits;
+    let (packed, search, bits) = match request.target {
+        None if auto.components || auto.weights => {
+            let model = CpcaModel::fit(&clip.frames, &request.params)
+                .map_err(|e| anim_error(&request.input, e))?;
+            let chosen = choose_bits_for(&model, &clip, &request.params, auto)
+                .map_err(|e| anim_error(&request.input, e))?;
+            (
+                chosen.compressed,
+                None,
+                Some((chosen.da_unquantized, chosen.tried)),
+            )
+        }
         None => (
             Compressed::encode(
                 &clip.frames,
@@ -300,6 +341,7 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
                 &request.params,
             )
             .map_err(|e| anim_error(&request.input, e))?,
+            None,
             None,
         ),
         Some(target) => {
@@ -319,7 +361,7 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
                 &mut report,
             )
             .map_err(|e| anim_error(&request.input, e))?;
-            (found.compressed, Some((found.steps, found.reached)))
+            (found.compressed, Some((found.steps, found.reached)), None)
         }
     };
     let encode_seconds = start.elapsed().as_secs_f64();
@@ -337,7 +379,47 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
         distortion,
         encode_seconds,
         search,
+        bits,
     })
+}
+
+/// [`choose_bits`], keeping a bit count the user fixed: when only one of q_c, q_w is chosen,
+/// it takes the value `choose_bits` picks with both free, the other stays as given, and the
+/// summary reports the d_a that pair measures.
+fn choose_bits_for(
+    model: &CpcaModel,
+    clip: &meshio::Animation,
+    params: &CpcaParams,
+    auto: AutoBits,
+) -> anim_pca::Result<anim_pca::compress::BitsChoice> {
+    let mut chosen = choose_bits(
+        model,
+        &clip.frames,
+        &clip.triangles,
+        clip.frame_rate,
+        params,
+        DEFAULT_BITS_TOLERANCE,
+    )?;
+    if auto.components && auto.weights {
+        return Ok(chosen);
+    }
+    // One fixed: re-encode with the fixed count and the chosen other.
+    let p = CpcaParams {
+        bits_components: if auto.components {
+            chosen.bits_components()
+        } else {
+            params.bits_components
+        },
+        bits_weights: if auto.weights {
+            chosen.bits_weights()
+        } else {
+            params.bits_weights
+        },
+        ..*params
+    };
+    chosen.compressed = Compressed::from_model(model, &clip.triangles, clip.frame_rate, &p)?;
+    chosen.tried += 1;
+    Ok(chosen)
 }
 
 /// Runs `decompress`: read and validate the `.cpca`, decode every frame, write them.
@@ -605,12 +687,13 @@ pub struct CompressArgs {
     /// c*: components of the second PCA along time (default: none).
     #[arg(long, value_name = "C*")]
     time_components: Option<usize>,
-    /// q_c: bits of the means and eigentrajectories, 1..=32.
-    #[arg(long, value_name = "BITS", default_value_t = anim_pca::compress::DEFAULT_BITS)]
-    qc: u8,
-    /// q_w: bits of the weights, 1..=32.
-    #[arg(long, value_name = "BITS", default_value_t = anim_pca::compress::DEFAULT_BITS)]
-    qw: u8,
+    /// q_c: bits of the means and eigentrajectories, 1..=32 (default: the fewest that add at
+    /// most 1 % to the unquantized d_a, measured; 18 with a target).
+    #[arg(long, value_name = "BITS")]
+    qc: Option<u8>,
+    /// q_w: bits of the weights, 1..=32 (default: chosen as q_c is; 18 with a target).
+    #[arg(long, value_name = "BITS")]
+    qw: Option<u8>,
     /// Seed of the local PCA (same seed, same file).
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -643,13 +726,17 @@ impl CompressArgs {
                 clusters: self.clusters,
                 components: self.components,
                 time_components: self.time_components,
-                bits_components: self.qc,
-                bits_weights: self.qw,
+                bits_components: self.qc.unwrap_or(anim_pca::compress::DEFAULT_BITS),
+                bits_weights: self.qw.unwrap_or(anim_pca::compress::DEFAULT_BITS),
                 seed: self.seed,
                 ..Default::default()
             },
             target,
             k_max: self.k_max,
+            auto_bits: AutoBits {
+                components: self.qc.is_none(),
+                weights: self.qw.is_none(),
+            },
             out: self.out,
         };
         super::print_line(&run_compress(&request)?.line())

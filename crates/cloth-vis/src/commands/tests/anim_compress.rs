@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use crate::commands::cpca::{
-    CompressRequest, DEFAULT_K_MAX, DecompressRequest, run_compress, run_decompress, run_stats,
+    AutoBits, CompressRequest, DEFAULT_K_MAX, DecompressRequest, run_compress, run_decompress,
+    run_stats,
 };
 use anim_pca::compress::{Compressed, Decoder, bpvf_from_file};
 use glam::Vec3;
@@ -88,6 +89,10 @@ fn round_trip_through_the_cli_reproduces_the_clip_and_stats_match_the_library() 
         "2",
         "--components",
         "4",
+        "--qc",
+        "18",
+        "--qw",
+        "18",
         "--out",
         text(&cpca),
     ]);
@@ -171,6 +176,7 @@ fn time_compression_and_obj_folder_output() {
         params,
         target: None,
         k_max: DEFAULT_K_MAX,
+        auto_bits: AutoBits::default(),
         out: cpca.clone(),
     })
     .unwrap();
@@ -236,6 +242,7 @@ fn time_compression_and_obj_folder_output() {
         params,
         target: None,
         k_max: DEFAULT_K_MAX,
+        auto_bits: AutoBits::default(),
         out: again.clone(),
     })
     .unwrap();
@@ -319,6 +326,7 @@ fn unsupported_outputs_are_refused_before_any_work() {
         params,
         target: None,
         k_max: DEFAULT_K_MAX,
+        auto_bits: AutoBits::default(),
         out: cpca.clone(),
     })
     .unwrap();
@@ -449,6 +457,7 @@ fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
         },
         target: Some(anim_pca::compress::RateTarget::Bpvf(40.0)),
         k_max: 4,
+        auto_bits: AutoBits::default(),
         out: roomy.clone(),
     })
     .unwrap();
@@ -670,7 +679,81 @@ fn compress_into(input: &Path, cpca: &Path, clusters: usize, components: usize) 
         },
         target: None,
         k_max: DEFAULT_K_MAX,
+        auto_bits: AutoBits::default(),
         out: cpca.to_owned(),
     })
     .unwrap();
+}
+
+#[test]
+fn default_bits_are_the_fewest_within_one_percent_of_the_unquantized_error() {
+    // Issue #19: 18-bit codes spent bits for nothing. Without --qc/--qw the bits are chosen:
+    // the decoded d_a stays within 1 % of the 32-bit (unquantized) d_a, and where the model
+    // itself is lossy (one cluster, one component for two bars turning at their own rates)
+    // the file is smaller than the thesis's 18/18 at the same k and c.
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = write_clip(dir.path());
+    let params = anim_pca::compress::CpcaParams {
+        clusters: 1,
+        components: 1,
+        ..Default::default()
+    };
+    let run = |auto_bits, params, name: &str| {
+        run_compress(&CompressRequest {
+            input: input.clone(),
+            params,
+            target: None,
+            k_max: DEFAULT_K_MAX,
+            auto_bits,
+            out: dir.path().join(name),
+        })
+        .unwrap()
+    };
+    let both = AutoBits {
+        components: true,
+        weights: true,
+    };
+    let chosen = run(both, params, "auto.cpca");
+    let (d0, tried) = chosen.bits.expect("bits were chosen");
+    assert!(tried <= 12, "{tried} encodings");
+    let bound = d0 + (0.01 * d0).max(anim_pca::compress::DA_FLOOR);
+    assert!(chosen.distortion.da <= bound, "{chosen:?}");
+    let fixed = run(AutoBits::default(), params, "fixed.cpca");
+    assert!(fixed.bits.is_none());
+    assert!(
+        chosen.file_bytes < fixed.file_bytes,
+        "chosen {} bytes, 18/18 {} bytes",
+        chosen.file_bytes,
+        fixed.file_bytes
+    );
+    assert!(chosen.line().contains("chosen"), "{}", chosen.line());
+    // One bit fewer of q_w breaks the 1 % (the bisection measured it).
+    let qw = chosen.rate.bits_weights;
+    if qw > 1 {
+        let fewer = anim_pca::compress::CpcaParams {
+            bits_components: chosen.rate.bits_components,
+            bits_weights: qw - 1,
+            ..params
+        };
+        let worse = run(AutoBits::default(), fewer, "fewer.cpca");
+        assert!(
+            worse.distortion.da > d0 * 1.01 + 1e-9,
+            "q_w {} also meets it",
+            qw - 1
+        );
+    }
+    // A fixed q_c is kept while q_w is chosen.
+    let only_w = run(
+        AutoBits {
+            components: false,
+            weights: true,
+        },
+        anim_pca::compress::CpcaParams {
+            bits_components: 20,
+            ..params
+        },
+        "only_w.cpca",
+    );
+    assert_eq!(only_w.rate.bits_components, 20);
+    assert_eq!(only_w.rate.bits_weights, qw);
 }
