@@ -1,17 +1,26 @@
-//! `cloth-vis inspect`: load a mesh or an animation and print what the loader found.
+//! `cloth-vis inspect`: load a mesh or an animation and print what the loader found, as a
+//! few readable lines (format, counts, extent, attributes, what was dropped and why), or the
+//! loader's whole report with `--debug`.
 
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
+
+use glam::Vec3;
+use meshio::{AttributeStatus, LoadReport};
 
 /// Load a mesh or an animation and print what the loader found (counts, quirks, time).
 #[derive(clap::Args)]
 pub struct InspectArgs {
     /// A mesh (.ply .obj .gltf .glb), an animation (.glb, .npy, a folder of numbered .obj).
     input: PathBuf,
-    /// Treat a glTF as an animation (default: static mesh).
+    /// Treat a glTF as an animation: sample its first clip, as `visibility` and the `anim`
+    /// commands do (default: the rest pose).
     #[arg(long)]
     animation: bool,
+    /// Print the loader's whole report (every field, every frame file) after the summary.
+    #[arg(long)]
+    debug: bool,
 }
 
 impl InspectArgs {
@@ -25,39 +34,153 @@ impl InspectArgs {
         };
         let mut out = std::io::stdout().lock();
         let start = Instant::now();
-        if self.animation || input.is_dir() || has_ext("npy") {
+        let (lines, report) = if self.animation || input.is_dir() || has_ext("npy") {
             let (anim, report) =
                 meshio::load_animation(input, &meshio::AnimationOptions::default())?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
-            writeln!(
-                out,
-                "{}: animation, {} frames x {} vertices, {} triangles, {:.1} fps, loaded in {ms:.1} ms",
+            let mut lines = vec![format!(
+                "{}: animation ({:?}), {} frames x {} vertices, {} triangles, {:.1} fps ({:.2} s), \
+                 loaded in {ms:.1} ms",
                 input.display(),
+                report.format,
                 anim.frame_count(),
                 anim.vertex_count(),
                 anim.triangles.len(),
-                anim.frame_rate
-            )?;
-            writeln!(out, "{report:#?}")?;
+                anim.frame_rate,
+                anim.frame_count() as f64 / f64::from(anim.frame_rate)
+            )];
+            let (lo, hi) = bounds(anim.frames.iter().flatten());
+            let travel = anim
+                .frames
+                .iter()
+                .map(|f| max_distance(&anim.frames[0], f))
+                .fold(0.0f32, f32::max);
+            lines.push(format!(
+                "extent over all frames: {} .. {} (diagonal {:.4}); largest vertex travel from \
+                 frame 0: {travel:.4}",
+                fmt3(lo),
+                fmt3(hi),
+                (hi - lo).length()
+            ));
+            if let Some(clip) = &report.clip {
+                lines.push(format!(
+                    "clip {} {:?}: {:.3} s … {:.3} s",
+                    clip.index,
+                    clip.name.as_deref().unwrap_or(""),
+                    clip.start_s,
+                    clip.end_s
+                ));
+            }
+            if let (Some(first), Some(last)) =
+                (report.frame_files.first(), report.frame_files.last())
+            {
+                lines.push(format!(
+                    "frame files: {} … {}",
+                    first.file_name().unwrap_or_default().to_string_lossy(),
+                    last.file_name().unwrap_or_default().to_string_lossy()
+                ));
+            }
+            (lines, report)
         } else {
             let (mesh, report) = meshio::load_mesh(input, &meshio::LoadOptions::default())?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
-            writeln!(
-                out,
-                "{}: {} vertices, {} triangles, loaded in {ms:.1} ms",
-                input.display(),
-                mesh.vertex_count(),
-                mesh.triangle_count()
-            )?;
-            writeln!(
-                out,
-                "unreferenced vertices: {}, degenerate triangles: {}, duplicate positions: {}, normals computed: {}",
-                report.unreferenced_vertices.len(),
-                report.degenerate_triangles.len(),
-                report.duplicate_positions,
-                report.normals_computed
-            )?;
+            let (lo, hi) = bounds(mesh.positions.iter());
+            let lines = vec![
+                format!(
+                    "{}: mesh ({:?}), {} vertices, {} triangles, loaded in {ms:.1} ms",
+                    input.display(),
+                    report.format,
+                    mesh.vertex_count(),
+                    mesh.triangle_count()
+                ),
+                format!(
+                    "extent: {} .. {} (diagonal {:.4})",
+                    fmt3(lo),
+                    fmt3(hi),
+                    (hi - lo).length()
+                ),
+            ];
+            (lines, report)
+        };
+        for line in lines.iter().chain(&report_lines(&report)) {
+            writeln!(out, "{line}")?;
+        }
+        if self.debug {
+            writeln!(out, "{report:#?}")?;
         }
         Ok(())
     }
+}
+
+/// The loader's findings as readable lines: attributes, what the file holds that was
+/// triangulated, dropped or skipped, and its notes.
+fn report_lines(report: &LoadReport) -> Vec<String> {
+    let status = |s: &AttributeStatus| match s {
+        AttributeStatus::Absent => "none in the file".to_owned(),
+        AttributeStatus::Loaded => "loaded".to_owned(),
+        other => format!("dropped: {other:?}"),
+    };
+    let mut lines = vec![format!(
+        "normals: {}{}; texture coordinates: {}",
+        status(&report.file_normals),
+        if report.normals_computed {
+            " (computed from the triangles)"
+        } else {
+            ""
+        },
+        status(&report.uvs)
+    )];
+    lines.push(format!(
+        "as written: {} vertices, {} faces ({} triangles, {} polygons fan-triangulated); \
+         unreferenced vertices: {}, degenerate triangles: {}, duplicate positions: {}",
+        report.file_vertex_count,
+        report.file_face_count,
+        report.file_triangle_count,
+        report.polygons_triangulated,
+        report.unreferenced_vertices.len(),
+        report.degenerate_triangles.len(),
+        report.duplicate_positions
+    ));
+    if report.removed_triangles + report.removed_vertices > 0 {
+        lines.push(format!(
+            "removed: {} triangles, {} vertices",
+            report.removed_triangles, report.removed_vertices
+        ));
+    }
+    if report.topology_missing {
+        lines.push("no triangles: an .npy clip without a topology mesh".to_owned());
+    }
+    if !report.skipped_keywords.is_empty() {
+        let skipped: Vec<String> = report
+            .skipped_keywords
+            .iter()
+            .map(|(k, n)| format!("{k} ×{n}"))
+            .collect();
+        lines.push(format!("skipped keywords: {}", skipped.join(", ")));
+    }
+    if !report.skipped_properties.is_empty() {
+        lines.push(format!(
+            "skipped properties: {}",
+            report.skipped_properties.join(", ")
+        ));
+    }
+    lines.extend(report.notes.iter().map(|n| format!("note: {n}")));
+    lines
+}
+
+fn bounds<'a>(points: impl Iterator<Item = &'a Vec3>) -> (Vec3, Vec3) {
+    points.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+        (lo.min(*p), hi.max(*p))
+    })
+}
+
+fn max_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0, f32::max)
+}
+
+fn fmt3(v: Vec3) -> String {
+    format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
 }

@@ -1,0 +1,53 @@
+//! `cloth-vis inspect`: a readable summary of what the loader found (issue #18: it printed a
+//! Rust `Debug` dump), and the dump itself only with `--debug`.
+
+use super::common::{cli, text};
+
+#[test]
+fn inspect_summarises_a_mesh_and_an_animation() {
+    let dir = tempfile::tempdir().unwrap();
+    // A quad (fan-triangulated), a triangle, an unreferenced vertex, an unknown keyword.
+    let obj = dir.path().join("quad.obj");
+    std::fs::write(
+        &obj,
+        "o thing\nv 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 5 5 5\nf 1 2 3 4\nf 1 2 3\n",
+    )
+    .unwrap();
+    let out = cli(&["inspect", text(&obj)]);
+    assert!(out.status.success(), "{out:?}");
+    let s = String::from_utf8(out.stdout).unwrap();
+    assert!(s.contains("mesh (Obj), 5 vertices, 3 triangles"), "{s}");
+    assert!(
+        s.contains("extent: (0.0000, 0.0000, 0.0000) .. (5.0000, 5.0000, 5.0000)"),
+        "{s}"
+    );
+    assert!(s.contains("1 polygons fan-triangulated"), "{s}");
+    assert!(s.contains("unreferenced vertices: 1"), "{s}");
+    assert!(s.contains("skipped keywords: o ×1"), "{s}");
+    assert!(!s.contains("LoadReport {"), "{s}");
+    let debug = String::from_utf8(cli(&["inspect", text(&obj), "--debug"]).stdout).unwrap();
+    assert!(debug.contains("LoadReport {"), "{debug}");
+
+    // Two OBJ frames: the second moves vertex 2 by 3 units.
+    let frames = dir.path().join("frames");
+    std::fs::create_dir(&frames).unwrap();
+    for (i, z) in [(1, 0.0), (2, 3.0)] {
+        std::fs::write(
+            frames.join(format!("{i:04}.obj")),
+            format!("v 0 0 0\nv 1 0 0\nv 0 1 {z}\nf 1 2 3\n"),
+        )
+        .unwrap();
+    }
+    let out = cli(&["inspect", text(&frames)]);
+    assert!(out.status.success(), "{out:?}");
+    let s = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        s.contains("animation (ObjFrames), 2 frames x 3 vertices, 1 triangles"),
+        "{s}"
+    );
+    assert!(
+        s.contains("largest vertex travel from frame 0: 3.0000"),
+        "{s}"
+    );
+    assert!(s.contains("frame files: 0001.obj … 0002.obj"), "{s}");
+}
