@@ -101,6 +101,6 @@ pub use level::{
     DEFAULT_MAX_IDLE_LEVEL, DEFAULT_MAX_LEVEL, DEFAULT_MIN_LEVEL, DEFAULT_RISE_AFTER_FRAMES,
     DEFAULT_RISE_FRACTION, LevelChange, LevelController, LevelParams,
 };
-pub use matrix::VisibilityMatrix;
+pub use matrix::{VisibilityMatrix, clamp_ambient};
 pub use rigid::RigidLighting;
 pub use scene::{MAX_ELEMENTS, Scene, SceneObject};

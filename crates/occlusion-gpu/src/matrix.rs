@@ -145,7 +145,8 @@ impl VisibilityMatrix {
     }
 
     /// The ambient term a_i = (1/π) Σ_j ω_j M_ij (1 for a fully open vertex up to quadrature),
-    /// accumulated in f64. Vertices with a zero normal (used by no triangle) get NaN.
+    /// accumulated in f64 and clamped to [0, 1] ([`clamp_ambient`]). Vertices with a zero
+    /// normal (used by no triangle) get NaN.
     pub fn ambient(&self) -> Vec<f32> {
         (0..self.rows)
             .map(|i| {
@@ -157,7 +158,7 @@ impl VisibilityMatrix {
                     .visible_columns(i)
                     .map(|j| self.weights[j] * n.dot(self.directions[j].as_dvec3()))
                     .sum();
-                (sum / PI) as f32
+                clamp_ambient((sum / PI) as f32)
             })
             .collect()
     }
@@ -235,5 +236,19 @@ impl VisibilityMatrix {
                 .copy_from_slice(&subset.bits[r * w..(r + 1) * w]);
             self.normals[target] = subset.normals[r];
         }
+    }
+}
+
+/// a_i into [0, 1], NaN kept: the lightsphere's quadrature of ∫ cos θ dω / π over an open
+/// hemisphere is 1 only up to its error (up to 1.0031 at level 3), and a fully occluded vertex
+/// sums nothing, which Rust's float `sum` returns as −0.0; both are written as what a_i means,
+/// an open fraction in [0, 1], with +0.0 for "fully occluded".
+pub fn clamp_ambient(a: f32) -> f32 {
+    if a.is_nan() {
+        a
+    } else if a <= 0.0 {
+        0.0
+    } else {
+        a.min(1.0)
     }
 }

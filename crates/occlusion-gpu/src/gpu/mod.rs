@@ -584,7 +584,8 @@ impl DepthRun {
         self.words_per_row
     }
 
-    /// Reads a_i back (N floats); NaN for vertices with a zero normal.
+    /// Reads a_i back (N floats, clamped to [0, 1] as the CPU's); NaN for vertices with a
+    /// zero normal.
     pub(crate) fn read_ambient(
         &self,
         device: &wgpu::Device,
@@ -594,9 +595,11 @@ impl DepthRun {
             .map_err(|e| OcclusionError::Readback(e.to_string()))?;
         let mut ambient: Vec<f32> = bytemuck::pod_collect_to_vec(&bytes);
         for (a, &zero) in ambient.iter_mut().zip(&self.zero_normals) {
-            if zero {
-                *a = f32::NAN;
-            }
+            *a = if zero {
+                f32::NAN
+            } else {
+                crate::matrix::clamp_ambient(*a)
+            };
         }
         Ok(ambient)
     }
