@@ -221,6 +221,29 @@ fn crafted_hdr_decodes_rgbe_exactly() {
 }
 
 #[test]
+fn hdr_signatures_of_other_programs_decode_the_same() {
+    // Mitsuba writes `#?RGBE`; stb_image reads it. Any "#?" + program name is a Radiance file.
+    let dir = tempfile::tempdir().unwrap();
+    let radiance = dir.path().join("radiance.hdr");
+    write_flat_hdr(&radiance, 2, 1, &[[128, 64, 32, 129], [0, 0, 0, 0]]);
+    let reference = Environment::load(&radiance).unwrap();
+    let bytes = std::fs::read(&radiance).unwrap();
+    for signature in ["#?RGBE", "#?MITSUBA", "#?RADIANCE\r"] {
+        let path = dir.path().join("other.hdr");
+        let mut renamed = signature.as_bytes().to_vec();
+        renamed.extend_from_slice(&bytes["#?RADIANCE".len()..]);
+        std::fs::write(&path, renamed).unwrap();
+        let env = Environment::load(&path).unwrap_or_else(|e| panic!("{signature}: {e}"));
+        assert_eq!(env.texels(), reference.texels(), "{signature}");
+    }
+    // Not a signature at all: still an error naming the file.
+    let path = dir.path().join("not.hdr");
+    std::fs::write(&path, [b"P6 1 1 255\n".as_slice(), &bytes[11..]].concat()).unwrap();
+    let err = Environment::load(&path).unwrap_err();
+    assert!(err.to_string().contains("not.hdr"), "{err}");
+}
+
+#[test]
 fn truncated_hdr_is_an_error_not_a_panic() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("cut.hdr");

@@ -7,8 +7,12 @@
 use super::{Environment, check_size};
 use crate::LightsphereError;
 use image::ImageDecoder;
-use std::io::BufReader;
+use std::io::{BufRead as _, BufReader, Read as _};
 use std::path::Path;
+
+/// The longest first line a Radiance file may start with before its program name is judged
+/// not to be a signature.
+const SIGNATURE_MAX: u64 = 64;
 
 const HDR: &str = "Radiance HDR";
 const EXR: &str = "OpenEXR";
@@ -55,8 +59,22 @@ fn load_hdr(path: &Path) -> Result<Environment, LightsphereError> {
         .metadata()
         .map_err(|e| io_error(path, "stat", e))?
         .len();
+    // Radiance files open with "#?" and the writing program's name: `#?RADIANCE` from most
+    // tools, `#?RGBE` from Mitsuba and others (stb_image reads both). The decoder knows only
+    // the first, so any other program name is read as if it were RADIANCE.
+    let mut reader = BufReader::new(file);
+    let mut first = Vec::new();
+    reader
+        .by_ref()
+        .take(SIGNATURE_MAX)
+        .read_until(b'\n', &mut first)
+        .map_err(|e| io_error(path, "read", e))?;
+    let program = first.strip_prefix(b"#?").map(|p| p.trim_ascii_end());
+    if program.is_some_and(|p| !p.is_empty() && p.iter().all(u8::is_ascii_alphanumeric)) {
+        first = b"#?RADIANCE\n".to_vec();
+    }
     // Reads and parses the header only.
-    let decoder = image::codecs::hdr::HdrDecoder::new(BufReader::new(file))
+    let decoder = image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(first).chain(reader))
         .map_err(|e| decode_error(path, HDR, e))?;
     let (width, height) = decoder.dimensions();
     let (width, height) = (width as usize, height as usize);
