@@ -445,3 +445,33 @@ fn quarter_turn_keyframes_rotate_a_rigid_node() {
     assert_close(anim.frames[1][0], Vec3::new(h, 0.0, -h), TOL);
     assert_close(anim.frames[2][0], Vec3::new(0.0, 0.0, -1.0), TOL);
 }
+
+/// Issue #18: a Draco or meshopt file failed with "accessors[0].bufferView: Missing data".
+/// The error names the extension, what it is and what to do.
+#[test]
+fn compressed_geometry_extensions_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    for (extension, hint) in [
+        ("KHR_draco_mesh_compression", "without Draco"),
+        ("EXT_meshopt_compression", "gltfpack without -c"),
+    ] {
+        let doc = json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": [extension],
+            "extensionsRequired": [extension],
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "accessors": [{"componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]}],
+        });
+        let path = common::write(dir.path(), "packed.gltf", serde_json::to_vec(&doc).unwrap());
+        let message = load_mesh(&path, &LoadOptions::default())
+            .unwrap_err()
+            .to_string();
+        for needle in ["packed.gltf", "extensionsRequired[0]", extension, hint] {
+            assert!(message.contains(needle), "{needle:?} missing: {message}");
+        }
+        assert!(!message.contains("Missing data"), "{message}");
+    }
+}

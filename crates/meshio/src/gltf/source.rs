@@ -151,6 +151,24 @@ fn validate(path: &Path, root: &gltf::json::Root) -> Result<(), MeshIoError> {
             }
         }
     }
+    for (i, extension) in root.extensions_required.iter().enumerate() {
+        let what = match extension.as_str() {
+            "KHR_draco_mesh_compression" => {
+                "Draco-compressed geometry, which is not decoded here: export the file \
+                 without Draco compression (Blender's glTF exporter: Compression off)"
+            }
+            "EXT_meshopt_compression" | "KHR_meshopt_compression" => {
+                "meshoptimizer-compressed buffers (gltfpack -c/-cc), which are not decoded \
+                 here yet: run gltfpack without -c/-cc"
+            }
+            _ => continue,
+        };
+        return Err(gltf_error(
+            path,
+            format!("extensionsRequired[{i}]"),
+            format!("the file requires {extension}: {what}"),
+        ));
+    }
     let mut problems = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |where_, error| {
         problems.push(format!("{}: {error}", where_()));
