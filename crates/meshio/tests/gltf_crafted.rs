@@ -475,3 +475,69 @@ fn compressed_geometry_extensions_are_named() {
         assert!(!message.contains("Missing data"), "{message}");
     }
 }
+
+/// KHR_mesh_quantization (what gltfpack writes by default): integer positions, dequantized by
+/// the node's scale and translation (unsigned short) or by normalisation (signed short,
+/// normalised). Both load to the float triangle within f32 rounding.
+#[test]
+fn quantized_positions_are_dequantized() {
+    let dir = tempfile::tempdir().unwrap();
+    let expected = [
+        Vec3::new(-1.0, 0.0, 0.5),
+        Vec3::new(1.0, 0.0, 0.5),
+        Vec3::new(0.0, 2.0, -0.5),
+    ];
+    // Unsigned short, scale 2/65535 per step from the translation (-1, 0, -0.5).
+    let step = 2.0 / 65535.0;
+    let to_u16 = |p: Vec3| {
+        ((p - Vec3::new(-1.0, 0.0, -0.5)) / step)
+            .round()
+            .to_array()
+            .map(|x| x as u16)
+    };
+    // Signed short normalised: x / 32767 in [-1, 1], then the node scale 2.
+    let to_i16 = |p: Vec3| (p / 2.0 * 32767.0).round().to_array().map(|x| x as i16);
+    for (name, component_type, normalized, scale, translation) in [
+        ("u16.gltf", 5123, false, [step; 3], [-1.0, 0.0, -0.5]),
+        ("i16.gltf", 5122, true, [2.0f32; 3], [0.0, 0.0, 0.0]),
+    ] {
+        let mut b = Builder::default();
+        // VEC3 of 2-byte components, padded to a 4-byte stride as glTF requires.
+        let mut bytes = Vec::new();
+        for p in expected {
+            let q: [u16; 3] = if component_type == 5123 {
+                to_u16(p)
+            } else {
+                to_i16(p).map(|x| x as u16)
+            };
+            for x in q.into_iter().chain([0]) {
+                bytes.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        let view = b.view(&bytes);
+        b.views[view]["byteStride"] = json!(8);
+        b.views[view]["target"] = json!(34962);
+        let (lo, hi) = if component_type == 5123 {
+            (json!([0, 0, 0]), json!([65535, 65535, 65535]))
+        } else {
+            (json!([-16384, 0, -8192]), json!([16384, 32767, 8192]))
+        };
+        b.accessors
+            .push(json!({"bufferView": view, "componentType": component_type,
+            "normalized": normalized, "count": 3, "type": "VEC3", "min": lo, "max": hi}));
+        let doc = json!({
+            "extensionsUsed": ["KHR_mesh_quantization"],
+            "extensionsRequired": ["KHR_mesh_quantization"],
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0, "scale": scale, "translation": translation}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        });
+        let path = b.write_gltf(doc, dir.path(), name);
+        let (mesh, _) =
+            load_mesh(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        for (got, want) in mesh.positions.iter().zip(expected) {
+            // Half a quantization step of 2/65535 (u16) or 2/32767 (i16).
+            assert_close(*got, want, 2.0 / 32767.0);
+        }
+    }
+}
