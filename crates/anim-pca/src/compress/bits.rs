@@ -56,8 +56,16 @@ impl BitsChoice {
 }
 
 /// The fewest q_c, then q_w, bits whose decoded clip stays within `tolerance` (a fraction,
-/// e.g. [`DEFAULT_BITS_TOLERANCE`]) of the unquantized d_a (see the [module docs](self)).
-/// `params` gives c* (its bit counts are ignored); `frames` is the clip `model` was fitted to.
+/// e.g. [`DEFAULT_BITS_TOLERANCE`]) of the unquantized d_a. `params` gives c* (its bit counts
+/// are ignored); `frames` is the clip `model` was fitted to.
+///
+/// The model is encoded with 32-bit codes (below f32 precision: the unquantized d_a, d₀);
+/// then bisection finds the fewest q_c bits whose decoded d_a stays within d₀ + a/2 with q_w
+/// still at 32, and the fewest q_w bits with that q_c within d₀ + a, where the allowance
+/// a = max(d₀·tolerance, [`DA_FLOOR`]). Each candidate is judged by its decoded d_a, so the
+/// returned pair always meets the bound, and one bit fewer of q_w (when above 1) was measured
+/// to break it. About 11 encodings of the fitted model (§3.3.2 "Quantization" advises 18 bits
+/// for both, which spends bits for nothing on lossy models: issue #19).
 ///
 /// # Errors
 /// [`crate::AnimPcaError::InvalidParameter`] for a tolerance that is not finite and ≥ 0;
