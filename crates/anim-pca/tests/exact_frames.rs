@@ -4,19 +4,12 @@
 
 mod common;
 
+use common::drape;
+
 use anim_pca::{
     Blend, GeneratedFrame, JumpMap, JumpMapParams, LoopTable, PlaybackParams, Player, RootMotion,
 };
 use glam::Vec3;
-
-fn drape() -> Vec<Vec<Vec3>> {
-    let params = synth::ClothParams {
-        grid: 20,
-        frames: 90,
-        ..Default::default()
-    };
-    synth::simulate_cloth(&params).unwrap().frames
-}
 
 fn frames_of(map: &JumpMap, clip: &[Vec<Vec3>], run: &[GeneratedFrame]) -> Vec<Vec<Vec3>> {
     let refs: Vec<&[Vec3]> = clip.iter().map(Vec::as_slice).collect();

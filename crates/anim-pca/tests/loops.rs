@@ -5,7 +5,7 @@ mod common;
 
 use anim_pca::jumpmap::loops::LOOP_CANDIDATES;
 use anim_pca::{AnimPcaError, Blend, JumpMap, JumpMapParams, LoopTable};
-use common::{assert_close, wave_clip, wave_with_tail};
+use common::{assert_acceptable, assert_close, wave_clip, wave_with_tail};
 
 const PERIOD: usize = 12;
 
@@ -195,24 +195,6 @@ fn bad_parameters_are_named() {
         LoopTable::build(&map, 0, 10, Blend::Smoothness(f64::NAN)),
         Err(AnimPcaError::InvalidParameter { .. })
     ));
-}
-
-/// Every loop of `table` obeys the rule of the module docs: each stretch of natural play lasts
-/// at least R(n) key frames, so the loop shows at least R(n) distinct clip frames.
-fn assert_acceptable(name: &str, table: &LoopTable) -> usize {
-    let mut count = 0;
-    for lp in table.iter() {
-        let r = table.min_run(lp.len());
-        assert!(
-            lp.shortest_run() >= r && lp.distinct_frames() >= r,
-            "{name}: loop of {} frames has a stretch of {} and {} distinct frames (R = {r})",
-            lp.len(),
-            lp.shortest_run(),
-            lp.distinct_frames()
-        );
-        count += 1;
-    }
-    count
 }
 
 #[test]

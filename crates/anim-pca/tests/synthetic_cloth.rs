@@ -3,20 +3,13 @@
 //! is the slow middle (frames ≈ 27–79 of 90 at grid 20). The repository's own sequence, so
 //! this runs on a fresh clone without ../shared/data.
 
+mod common;
+
 use anim_pca::jumpmap::metrics::{
     clip_max_velocity_change, reconstruction_errors, sequence_stats, transition_velocity_change,
 };
 use anim_pca::{Blend, JumpMap, JumpMapParams, LoopTable, PlaybackParams, Player};
-use glam::Vec3;
-
-fn drape() -> Vec<Vec<Vec3>> {
-    let params = synth::ClothParams {
-        grid: 20,
-        frames: 90,
-        ..Default::default()
-    };
-    synth::simulate_cloth(&params).unwrap().frames
-}
+use common::drape;
 
 #[test]
 fn drape_plays_endlessly_and_smoothly() {

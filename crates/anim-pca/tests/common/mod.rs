@@ -44,3 +44,32 @@ pub fn wave_with_tail(side: usize, frames: usize, period: f32, tail: usize) -> V
 pub fn assert_close(a: f64, b: f64, tol: f64) {
     assert!((a - b).abs() <= tol, "{a} vs {b} (tolerance {tol})");
 }
+
+/// The synthetic drape (20 × 20 cloth over a sphere, 90 frames) the jump-map tests play.
+pub fn drape() -> Vec<Vec<Vec3>> {
+    let params = synth::ClothParams {
+        grid: 20,
+        frames: 90,
+        ..Default::default()
+    };
+    synth::simulate_cloth(&params).unwrap().frames
+}
+
+/// Asserts that every loop of `table` obeys the no-oscillation rule (`LoopTable::min_run`):
+/// each stretch of natural play lasts at least R(n) key frames, so the loop shows at least
+/// R(n) distinct clip frames. Returns how many loops the table holds.
+pub fn assert_acceptable(name: &str, table: &anim_pca::LoopTable) -> usize {
+    let mut count = 0;
+    for lp in table.iter() {
+        let r = table.min_run(lp.len());
+        assert!(
+            lp.shortest_run() >= r && lp.distinct_frames() >= r,
+            "{name}: loop of {} frames has a stretch of {} and {} distinct frames (R = {r})",
+            lp.len(),
+            lp.shortest_run(),
+            lp.distinct_frames()
+        );
+        count += 1;
+    }
+    count
+}

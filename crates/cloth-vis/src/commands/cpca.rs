@@ -19,10 +19,12 @@ use std::time::Instant;
 
 use anim_pca::compress::{
     Compressed, CpcaModel, CpcaParams, DEFAULT_BITS_TOLERANCE, Decoder, Distortion, RateParams,
-    RateTarget, SearchStep, bpvf_from_file, choose_bits, search_clusters,
+    RateTarget, SearchStep, bpvf_from_file, search_clusters,
 };
 use glam::Vec3;
 
+pub use super::cpca_bits::AutoBits;
+use super::cpca_bits::choose_bits_for;
 use super::{anim_error, invalid};
 use cloth_vis::Error;
 
@@ -44,16 +46,6 @@ pub struct CompressRequest {
     pub auto_bits: AutoBits,
     /// The `.cpca` file to write.
     pub out: PathBuf,
-}
-
-/// Which quantization bit counts `compress` chooses itself (those not given on the command
-/// line).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct AutoBits {
-    /// Choose q_c.
-    pub components: bool,
-    /// Choose q_w.
-    pub weights: bool,
 }
 
 /// Largest k `--target-da`/`--target-bpvf` tries unless told (`--k-max`).
@@ -381,45 +373,6 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
         search,
         bits,
     })
-}
-
-/// [`choose_bits`], keeping a bit count the user fixed: when only one of q_c, q_w is chosen,
-/// it takes the value `choose_bits` picks with both free, the other stays as given, and the
-/// summary reports the d_a that pair measures.
-fn choose_bits_for(
-    model: &CpcaModel,
-    clip: &meshio::Animation,
-    params: &CpcaParams,
-    auto: AutoBits,
-) -> anim_pca::Result<anim_pca::compress::BitsChoice> {
-    let mut chosen = choose_bits(
-        model,
-        &clip.frames,
-        &clip.triangles,
-        clip.frame_rate,
-        params,
-        DEFAULT_BITS_TOLERANCE,
-    )?;
-    if auto.components && auto.weights {
-        return Ok(chosen);
-    }
-    // One fixed: re-encode with the fixed count and the chosen other.
-    let p = CpcaParams {
-        bits_components: if auto.components {
-            chosen.bits_components()
-        } else {
-            params.bits_components
-        },
-        bits_weights: if auto.weights {
-            chosen.bits_weights()
-        } else {
-            params.bits_weights
-        },
-        ..*params
-    };
-    chosen.compressed = Compressed::from_model(model, &clip.triangles, clip.frame_rate, &p)?;
-    chosen.tried += 1;
-    Ok(chosen)
 }
 
 /// Runs `decompress`: read and validate the `.cpca`, decode every frame, write them.

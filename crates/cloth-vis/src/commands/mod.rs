@@ -5,6 +5,7 @@
 pub mod anim;
 pub mod btf;
 pub mod cpca;
+mod cpca_bits;
 pub mod inspect;
 pub mod jumpmap;
 pub mod parse;
