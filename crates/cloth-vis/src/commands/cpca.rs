@@ -33,6 +33,8 @@ use cloth_vis::Error;
 pub struct CompressRequest {
     /// The clip: a folder of numbered OBJ frames, `.npy` [F, V, 3] or an animated glTF.
     pub input: PathBuf,
+    /// Which of its glTF clips (the first unless told).
+    pub clip: meshio::ClipSelector,
     /// k, c, c*, q_c, q_w, seed and the local-PCA limits.
     pub params: CpcaParams,
     /// Search k = 1, 2, … for this target instead of using `params.clusters`
@@ -310,7 +312,8 @@ pub fn read_cpca(path: &Path) -> Result<(Compressed, usize), Error> {
 pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error> {
     check_cpca_out(&request.out)?;
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
-    let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
+    let (clip, _) =
+        meshio::load_animation(&request.input, &super::animation_options(&request.clip))?;
     let start = Instant::now();
     let auto = request.auto_bits;
     let (packed, search, bits) = match request.target {
@@ -477,6 +480,7 @@ pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
     run_stats_with_pictures(
         &StatsRequest {
             original: original.to_owned(),
+            clip: meshio::ClipSelector::First,
             cpca: cpca.to_owned(),
             clusters_png: None,
             error_plot: None,
@@ -490,6 +494,8 @@ pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
 pub struct StatsRequest {
     /// The original clip.
     pub original: PathBuf,
+    /// Which of its glTF clips (the one compressed; the first unless told).
+    pub clip: meshio::ClipSelector,
     /// The `.cpca` file.
     pub cpca: PathBuf,
     /// Write the decoded mesh coloured by cluster (thesis Figs. 3.12/3.13) here, as a PNG
@@ -535,7 +541,7 @@ pub fn run_stats_with_pictures(
         ));
     }
     let (data, file_bytes) = read_cpca(cpca)?;
-    let (clip, _) = meshio::load_animation(original, &meshio::AnimationOptions::default())?;
+    let (clip, _) = meshio::load_animation(original, &super::animation_options(&request.clip))?;
     let (f, v) = (
         clip.frames.len(),
         clip.frames.first().map_or(0, std::vec::Vec::len),
@@ -545,7 +551,8 @@ pub fn run_stats_with_pictures(
             original,
             format!(
                 "has {f} frames x {v} vertices but {} holds {} frames x {} vertices; compare a \
-                 .cpca with the clip it was compressed from",
+                 .cpca with the clip it was compressed from (a glTF with several clips: \
+                 --clip NAME|INDEX names the one that was compressed)",
                 cpca.display(),
                 data.frames(),
                 data.vertices()
@@ -631,6 +638,10 @@ fn glb_frame_rate(rate: f32) -> f32 {
 pub struct CompressArgs {
     /// The clip: a folder of numbered .obj frames, .npy [F, V, 3] or an animated .glb.
     input: PathBuf,
+    /// The glTF animation to sample, by name or index (default: the file's first; other
+    /// formats hold one clip).
+    #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
+    clip: Option<meshio::ClipSelector>,
     /// k: vertex clusters (clamped to V).
     #[arg(long, default_value_t = CpcaParams::default().clusters)]
     clusters: usize,
@@ -675,6 +686,7 @@ impl CompressArgs {
         };
         let request = CompressRequest {
             input: self.input,
+            clip: self.clip.unwrap_or_default(),
             params: CpcaParams {
                 clusters: self.clusters,
                 components: self.components,
@@ -728,6 +740,10 @@ pub struct StatsArgs {
     original: PathBuf,
     /// The .cpca file.
     cpca: PathBuf,
+    /// The glTF animation to sample, by name or index (the one that was compressed; default: the first).
+    #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
+    clip: Option<meshio::ClipSelector>,
+
     /// Also write the decoded mesh coloured by cluster (Figs. 3.12/3.13) as a PNG strip.
     #[arg(long, value_name = "FILE.png")]
     clusters_png: Option<PathBuf>,
@@ -745,6 +761,7 @@ impl StatsArgs {
         };
         let request = StatsRequest {
             original: self.original,
+            clip: self.clip.unwrap_or_default(),
             cpca: self.cpca,
             clusters_png: self.clusters_png,
             error_plot: self.error_plot,

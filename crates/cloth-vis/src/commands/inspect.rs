@@ -18,6 +18,9 @@ pub struct InspectArgs {
     /// commands do (default: the rest pose).
     #[arg(long)]
     animation: bool,
+    /// The glTF animation to sample, by name or index (implies --animation).
+    #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
+    clip: Option<meshio::ClipSelector>,
     /// Print the loader's whole report (every field, every frame file) after the summary.
     #[arg(long)]
     debug: bool,
@@ -34,9 +37,10 @@ impl InspectArgs {
         };
         let mut out = std::io::stdout().lock();
         let start = Instant::now();
-        let (lines, report) = if self.animation || input.is_dir() || has_ext("npy") {
-            let (anim, report) =
-                meshio::load_animation(input, &meshio::AnimationOptions::default())?;
+        let animation = self.animation || self.clip.is_some() || input.is_dir() || has_ext("npy");
+        let (lines, report) = if animation {
+            let options = super::animation_options(&self.clip.clone().unwrap_or_default());
+            let (anim, report) = meshio::load_animation(input, &options)?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
             let mut lines = vec![format!(
                 "{}: animation ({:?}), {} frames x {} vertices, {} triangles, {:.1} fps ({:.2} s), \

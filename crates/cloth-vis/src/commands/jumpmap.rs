@@ -60,6 +60,8 @@ pub struct PlayControl {
 pub struct JumpMapRequest {
     /// The clip: a folder of numbered OBJ frames, `.npy` [F, V, 3] or an animated glTF.
     pub input: PathBuf,
+    /// Which of the input's glTF clips (the first unless told; `--cell` files use their first).
+    pub clip: meshio::ClipSelector,
     /// Analysis parameters (c, c*, σ, σ*, q, q*, root motion).
     pub params: JumpMapParams,
     /// Cells, a cell schedule or a loop length.
@@ -265,7 +267,8 @@ pub fn run_jumpmap(
             Some((strip, gpu))
         }
     };
-    let (clip, _) = meshio::load_animation(&request.input, &meshio::AnimationOptions::default())?;
+    let (clip, _) =
+        meshio::load_animation(&request.input, &super::animation_options(&request.clip))?;
     // The generated run is held in memory before it is written: bound it by a named limit
     // rather than growing until the kernel kills the process (issue #12).
     let run_bytes = (request.frames as u128) * (clip.vertex_count() as u128) * 12;
@@ -600,6 +603,10 @@ pub fn blend_from_flags(blend: Option<usize>, smoothness: Option<f64>) -> Blend 
 pub struct JumpmapArgs {
     /// The clip: a folder of numbered .obj frames, .npy [F, V, 3] or an animated .glb.
     input: PathBuf,
+    /// The glTF animation to sample, by name or index (default: the file's first; other
+    /// formats hold one clip).
+    #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
+    clip: Option<meshio::ClipSelector>,
     /// A further clip of the same mesh, analysed as the next cell (motion control,
     /// thesis §3.2.2); repeat for more cells. The input is cell 0.
     #[arg(long, value_name = "CLIP")]
@@ -699,6 +706,7 @@ impl JumpmapArgs {
     fn request(self) -> JumpMapRequest {
         JumpMapRequest {
             input: self.input,
+            clip: self.clip.unwrap_or_default(),
             params: JumpMapParams {
                 components: self.components,
                 velocity_components: self.velocity_components,

@@ -75,6 +75,14 @@ pub fn refuse_overwriting_input(
     Ok(())
 }
 
+/// Loader options for an animation input: the glTF clip `--clip` names, defaults otherwise.
+pub fn animation_options(clip: &meshio::ClipSelector) -> meshio::AnimationOptions {
+    meshio::AnimationOptions {
+        clip: clip.clone(),
+        ..meshio::AnimationOptions::default()
+    }
+}
+
 /// Print a command's one summary line on stdout.
 pub fn print_line(line: &str) -> anyhow::Result<()> {
     writeln!(std::io::stdout().lock(), "{line}")?;

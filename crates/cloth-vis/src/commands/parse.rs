@@ -63,3 +63,15 @@ mod tests {
         assert!(size("640").unwrap_err().contains("WxH"));
     }
 }
+
+/// Parse `--clip NAME|INDEX`: a glTF animation by its index in the file (digits) or its name.
+pub fn clip(text: &str) -> Result<meshio::ClipSelector, String> {
+    let text = text.trim();
+    if text.is_empty() {
+        return Err("give a clip name or index (e.g. --clip Walk or --clip 1)".to_owned());
+    }
+    Ok(match text.parse::<usize>() {
+        Ok(index) => meshio::ClipSelector::Index(index),
+        Err(_) => meshio::ClipSelector::Name(text.to_owned()),
+    })
+}

@@ -173,6 +173,7 @@ fn time_compression_and_obj_folder_output() {
     };
     let summary = run_compress(&CompressRequest {
         input: input.clone(),
+        clip: meshio::ClipSelector::First,
         params,
         target: None,
         k_max: DEFAULT_K_MAX,
@@ -239,6 +240,7 @@ fn time_compression_and_obj_folder_output() {
     let again = dir.path().join("again.cpca");
     run_compress(&CompressRequest {
         input,
+        clip: meshio::ClipSelector::First,
         params,
         target: None,
         k_max: DEFAULT_K_MAX,
@@ -323,6 +325,7 @@ fn unsupported_outputs_are_refused_before_any_work() {
     };
     run_compress(&CompressRequest {
         input,
+        clip: meshio::ClipSelector::First,
         params,
         target: None,
         k_max: DEFAULT_K_MAX,
@@ -451,6 +454,7 @@ fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
     let roomy = dir.path().join("roomy.cpca");
     let summary = run_compress(&CompressRequest {
         input: input.clone(),
+        clip: meshio::ClipSelector::First,
         params: anim_pca::compress::CpcaParams {
             components: 2,
             ..Default::default()
@@ -529,6 +533,7 @@ fn stats_draws_the_error_per_frame_and_the_clusters() {
     let Some(gpu) = gpu() else { return };
     // The npy clip has no triangles: a cluster picture of it is refused by name.
     let request = crate::commands::cpca::StatsRequest {
+        clip: meshio::ClipSelector::First,
         original: input.clone(),
         cpca: cpca.clone(),
         clusters_png: Some(dir.path().join("clusters.png")),
@@ -672,6 +677,7 @@ fn a_clip_too_long_for_glb_is_refused_before_decoding() {
 fn compress_into(input: &Path, cpca: &Path, clusters: usize, components: usize) {
     run_compress(&CompressRequest {
         input: input.to_owned(),
+        clip: meshio::ClipSelector::First,
         params: anim_pca::compress::CpcaParams {
             clusters,
             components,
@@ -701,6 +707,7 @@ fn default_bits_are_the_fewest_within_one_percent_of_the_unquantized_error() {
     let run = |auto_bits, params, name: &str| {
         run_compress(&CompressRequest {
             input: input.clone(),
+            clip: meshio::ClipSelector::First,
             params,
             target: None,
             k_max: DEFAULT_K_MAX,

@@ -56,6 +56,7 @@ fn write_clip_scaled(dir: &Path, amplitude: f32, travel: Vec3) -> Vec<Vec<Vec3>>
 fn request(input: PathBuf, out: PathBuf) -> JumpMapRequest {
     JumpMapRequest {
         input,
+        clip: meshio::ClipSelector::First,
         params: JumpMapParams::default(),
         control: PlayControl::default(),
         playback: PlaybackParams {

@@ -51,3 +51,30 @@ fn inspect_summarises_a_mesh_and_an_animation() {
     );
     assert!(s.contains("frame files: 0001.obj … 0002.obj"), "{s}");
 }
+
+#[test]
+fn clip_selects_a_gltf_animation_by_name_or_index() {
+    assert_eq!(
+        crate::commands::parse::clip("2"),
+        Ok(meshio::ClipSelector::Index(2))
+    );
+    assert_eq!(
+        crate::commands::parse::clip(" Walk "),
+        Ok(meshio::ClipSelector::Name("Walk".into()))
+    );
+    assert!(crate::commands::parse::clip(" ").is_err());
+    // Issue #18: only the Fox's first clip (Survey) was reachable.
+    let Some(fox) = test_data::shared_file("anim/gltf/Fox.glb") else {
+        return;
+    };
+    for (clip, expected) in [("Walk", "clip 1 \"Walk\""), ("2", "clip 2 \"Run\"")] {
+        let out = cli(&["inspect", text(&fox), "--clip", clip]);
+        assert!(out.status.success(), "{out:?}");
+        let s = String::from_utf8(out.stdout).unwrap();
+        assert!(s.contains(expected), "{s}");
+    }
+    let out = cli(&["inspect", text(&fox), "--clip", "Trot"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("Fox.glb") && err.contains("\"Walk\""), "{err}");
+}
