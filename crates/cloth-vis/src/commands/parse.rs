@@ -48,6 +48,18 @@ pub fn size(text: &str) -> Result<[u32; 2], String> {
     Ok([side(w)?, side(h)?])
 }
 
+/// Parse `--clip NAME|INDEX`: a glTF animation by its index in the file (digits) or its name.
+pub fn clip(text: &str) -> Result<meshio::ClipSelector, String> {
+    let text = text.trim();
+    if text.is_empty() {
+        return Err("give a clip name or index (e.g. --clip Walk or --clip 1)".to_owned());
+    }
+    Ok(match text.parse::<usize>() {
+        Ok(index) => meshio::ClipSelector::Index(index),
+        Err(_) => meshio::ClipSelector::Name(text.to_owned()),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -62,16 +74,4 @@ mod tests {
         assert_eq!(size("640X480"), Ok([640, 480]));
         assert!(size("640").unwrap_err().contains("WxH"));
     }
-}
-
-/// Parse `--clip NAME|INDEX`: a glTF animation by its index in the file (digits) or its name.
-pub fn clip(text: &str) -> Result<meshio::ClipSelector, String> {
-    let text = text.trim();
-    if text.is_empty() {
-        return Err("give a clip name or index (e.g. --clip Walk or --clip 1)".to_owned());
-    }
-    Ok(match text.parse::<usize>() {
-        Ok(index) => meshio::ClipSelector::Index(index),
-        Err(_) => meshio::ClipSelector::Name(text.to_owned()),
-    })
 }
