@@ -70,11 +70,13 @@ pub enum Error {
     Render(#[from] render::RenderError),
     /// An object's frame index is outside its animation.
     #[error(
-        "object {object}: frame {frame} is outside the animation's {count} frames (use 0..{count} or -1 for the last)"
+        "scene {origin}: {key}: frame {frame} is outside the animation's {count} frames (use 0..{count} or -1 for the last)"
     )]
     Frame {
-        /// Object name.
-        object: String,
+        /// Where the scene came from (file path or "embedded demo").
+        origin: String,
+        /// The scene key, `object[i] (name).frame`.
+        key: String,
         /// Requested frame.
         frame: i64,
         /// Frames available.

@@ -65,7 +65,7 @@ pub fn load_geometry(
             &cloth,
         ) {
             (GeometrySource::SynthCloth, Some(anim)) => {
-                let frame = frame_index(&desc.name, desc.frame, anim.frames.len())?;
+                let frame = frame_index(scene, index, anim.frames.len())?;
                 let detail = json!({ "source": "synth:cloth", "frame": frame, "frames": anim.frames.len(), "grid": anim.grid });
                 (
                     anim.frames[frame].clone(),
@@ -97,13 +97,29 @@ pub fn load_geometry(
                     None,
                 )
             }
-            (GeometrySource::File(path), _) => load_file(&path, desc)?,
+            (GeometrySource::File(path), _) => load_file(&path, scene, index)?,
         };
         let world_from_object = desc.world_from_object();
         let positions: Vec<Vec3> = positions
             .iter()
             .map(|p| world_from_object.transform_point3(*p))
             .collect();
+        // A huge scale or translation overflows f32 here or in the first squared length
+        // downstream (the camera framing); refused by the object's keys instead.
+        if let Some(p) = positions
+            .iter()
+            .find(|p| !(p.is_finite() && p.abs().max_element() <= MAX_WORLD_COORDINATE))
+        {
+            return Err(scene.invalid(
+                &format!("object[{index}] ({}).scale/translation", desc.name),
+                format!(
+                    "a vertex lands at {p}, beyond ±{MAX_WORLD_COORDINATE:e} \
+                     (cloth_vis::inputs::MAX_WORLD_COORDINATE; squared lengths would overflow \
+                     f32); scale {} and translation {:?} are too large",
+                    desc.scale, desc.translation
+                ),
+            ));
+        }
         // Normals are computed in world space from the transformed positions, so any transform
         // (including mirroring scales) keeps them consistent with the winding.
         let normals =
@@ -131,10 +147,17 @@ pub fn load_geometry(
     Ok((objects, serde_json::Value::Object(params)))
 }
 
+/// The largest world coordinate an object may reach after its scale and translation: its
+/// square stays far inside f32 (1e30 < 3.4e38), so bounding spheres and camera framing stay
+/// finite. Real assets (even a city in millimetres, ~1e7) sit far below it.
+pub const MAX_WORLD_COORDINATE: f32 = 1e15;
+
 /// Subdivision detail of the obstacle sphere mesh.
 const OBSTACLE_DETAIL: u32 = 4;
 
-fn frame_index(object: &str, frame: i64, count: usize) -> Result<usize, Error> {
+fn frame_index(scene: &Scene, index: usize, count: usize) -> Result<usize, Error> {
+    let desc = &scene.objects[index];
+    let frame = desc.frame;
     let resolved = if frame < 0 {
         count as i64 + frame
     } else {
@@ -142,7 +165,8 @@ fn frame_index(object: &str, frame: i64, count: usize) -> Result<usize, Error> {
     };
     if resolved < 0 || resolved >= count as i64 {
         return Err(Error::Frame {
-            object: object.to_owned(),
+            origin: scene.origin.clone(),
+            key: format!("object[{index}] ({}).frame", desc.name),
             frame,
             count,
         });
@@ -169,7 +193,7 @@ struct SharedCloth {
     obstacle: synth::Obstacle,
 }
 
-fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, Error> {
+fn load_file(path: &Path, scene: &Scene, index: usize) -> Result<Geometry, Error> {
     let has_ext = |ext: &str| {
         path.extension()
             .is_some_and(|e| e.eq_ignore_ascii_case(ext))
@@ -186,7 +210,7 @@ fn load_file(path: &Path, desc: &crate::scene::ObjectDesc) -> Result<Geometry, E
         None
     };
     if let Some((anim, report)) = animation {
-        let frame = frame_index(&desc.name, desc.frame, anim.frames.len())?;
+        let frame = frame_index(scene, index, anim.frames.len())?;
         let detail = json!({
             "source": path.display().to_string(),
             "frame": frame,

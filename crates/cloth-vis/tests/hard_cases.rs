@@ -52,6 +52,39 @@ height = 48
     assert!(centre[..3].iter().all(|c| *c > 0.0), "{centre:?}");
 }
 
+/// Issue #12 (scene values named by key): a scale or translation that puts the geometry
+/// beyond `MAX_WORLD_COORDINATE` was refused later as "camera.eye = [inf, inf, inf] once
+/// framed"; it is refused by the object's keys when the geometry is placed.
+#[test]
+fn a_transform_beyond_the_f32_range_is_refused_by_the_objects_keys() {
+    for (key, value) in [
+        ("scale", "1e30"),
+        ("translation", "[1e16, 0.0, 0.0]"),
+        ("translation", "[0.0, -3e38, 0.0]"),
+    ] {
+        let text = format!(
+            "[[object]]\nname = \"cloth\"\nsource = \"synth:cloth\"\n{key} = {value}\n{SMALL_SYNTH}"
+        );
+        let scene = Scene::from_toml(&text, ".".as_ref(), "big.toml").unwrap();
+        let message = cloth_vis::inputs::load_geometry(&scene, false)
+            .err()
+            .unwrap_or_else(|| panic!("{key} = {value} accepted"))
+            .to_string();
+        assert!(
+            message.contains("big.toml")
+                && message.contains("object[0] (cloth).scale/translation")
+                && message.contains("MAX_WORLD_COORDINATE"),
+            "{message}"
+        );
+    }
+    // The bound itself still loads: 1e5 offsets are exercised with a render below.
+    let text = format!(
+        "[[object]]\nname = \"cloth\"\nsource = \"synth:cloth\"\ntranslation = [1e14, 0.0, 0.0]\n{SMALL_SYNTH}"
+    );
+    let scene = Scene::from_toml(&text, ".".as_ref(), "big.toml").unwrap();
+    assert!(cloth_vis::inputs::load_geometry(&scene, false).is_ok());
+}
+
 #[test]
 fn frames_outside_the_animation_are_refused_with_the_count() {
     if !gpu_available() {
@@ -71,6 +104,12 @@ fn frames_outside_the_animation_are_refused_with_the_count() {
             }
         ),
         "{err}"
+    );
+    // Named by the scene and its key, as every other scene value is.
+    let message = err.to_string();
+    assert!(
+        message.contains("scene hard case") && message.contains("object[0] (cloth).frame"),
+        "{message}"
     );
     let text = format!(
         "[[object]]\nname = \"cloth\"\nsource = \"synth:cloth\"\nframe = -41\n{SMALL_SYNTH}"
@@ -191,6 +230,10 @@ fn sky_values_the_generator_refuses_are_named_by_scene_key_before_any_work() {
         assert!(
             message.contains("sky.toml") && message.contains(key),
             "{value}: {message}"
+        );
+        assert!(
+            !message.contains("SkyParams") && !message.contains("::"),
+            "named by the scene key only, not the library's field: {message}"
         );
     }
 }

@@ -398,7 +398,8 @@ impl Scene {
         Self::from_toml(&text, &base, &path.display().to_string())
     }
 
-    fn invalid(&self, key: &str, message: String) -> Error {
+    /// An [`Error::Scene`] naming this scene, `key` and `message`.
+    pub(crate) fn invalid(&self, key: &str, message: String) -> Error {
         Error::Scene {
             origin: self.origin.clone(),
             message: format!("{key}: {message}"),
@@ -650,14 +651,32 @@ impl Scene {
         // The sky the scene's `[synth]` keys set, checked by the generator itself but refused
         // here, before any work, by the scene's key rather than the library's field.
         if let Err(e) = crate::inputs::sky_params(self).validate() {
-            let key = match &e {
-                synth::SynthError::InvalidParameter { field, .. }
-                | synth::SynthError::TooLarge { field, .. } => match field.rsplit("::").next() {
-                    Some(f @ ("sun_elevation_deg" | "sun_azimuth_deg")) => format!("synth.{f}"),
-                    _ => "synth.sky_width".to_owned(),
-                },
+            let key = |field: &str| match field.rsplit("::").next() {
+                Some(f @ ("sun_elevation_deg" | "sun_azimuth_deg")) => format!("synth.{f}"),
+                _ => "synth.sky_width".to_owned(),
             };
-            return Err(self.invalid(&key, e.to_string()));
+            // Named by the scene's key only: the library's `Struct::field` means nothing to
+            // someone who wrote a TOML file.
+            let (key, message) = match &e {
+                synth::SynthError::InvalidParameter {
+                    field,
+                    value,
+                    expected,
+                } => (
+                    key(field),
+                    format!("{value} is not valid: expected {expected}"),
+                ),
+                synth::SynthError::TooLarge {
+                    field,
+                    requested,
+                    maximum,
+                    unit,
+                } => (
+                    key(field),
+                    format!("{requested} {unit} exceeds the maximum {maximum}"),
+                ),
+            };
+            return Err(self.invalid(&key, message));
         }
         if let Some(env) = &self.environment {
             let s = env.prefilter_sigma_deg;
