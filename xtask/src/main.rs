@@ -28,6 +28,7 @@ mod repro_anim_compression;
 mod repro_btf;
 mod repro_jumpmap;
 mod repro_lightsphere;
+mod repro_rd_search;
 mod repro_visibility;
 mod sequences;
 
@@ -94,6 +95,10 @@ enum Repro {
         /// Only the sequences whose name contains this (e.g. `chicken`).
         #[arg(long)]
         only: Option<String>,
+        /// Only the `--target-bpvf` search against its grid
+        /// (`anim-compression-search.md`; part of the full report too).
+        #[arg(long)]
+        search_only: bool,
     },
     /// BTF compression (thesis §5.4, §2.1.12): error, time and size against c (Figs. 5.7/5.8),
     /// FMF / PCMF / PVMF side by side (Fig. 2.22), and the 256² compression's time and peak
@@ -126,8 +131,8 @@ fn main() -> anyhow::Result<()> {
             what: Repro::Jumpmap,
         } => repro_jumpmap::run(&repro_dir()?),
         Command::Repro {
-            what: Repro::AnimCompression { only },
-        } => repro_anim_compression::run(&repro_dir()?, only.as_deref()),
+            what: Repro::AnimCompression { only, search_only },
+        } => repro_anim_compression::run(&repro_dir()?, only.as_deref(), search_only),
         Command::Repro {
             what: Repro::Btf { quick },
         } => repro_btf::run(&repro_dir()?, quick),

@@ -400,14 +400,21 @@ fn cluster_picture(
     Ok(name)
 }
 
-/// Runs the report into `out`, on the sequences whose name contains `only` (all by default).
-pub fn run(out: &Path, only: Option<&str>) -> anyhow::Result<()> {
+/// Runs the report into `out`, on the sequences whose name contains `only` (all by default);
+/// with `search_only`, only the search-against-grid section (`anim-compression-search.md`).
+pub fn run(out: &Path, only: Option<&str>, search_only: bool) -> anyhow::Result<()> {
     let total = Instant::now();
     let mut skipped = Vec::new();
     let mut sequences = load_sequences(&mut skipped, MAX_CLIP_FRAMES, "anim-compression")?;
     if let Some(only) = only {
         sequences.retain(|s| s.name.contains(only));
         anyhow::ensure!(!sequences.is_empty(), "no sequence name contains {only:?}");
+    }
+    let search = crate::repro_rd_search::section(&sequences)?;
+    atomic_out::write_bytes(&out.join("anim-compression-search.md"), search.as_bytes())?;
+    eprintln!("wrote {}", out.join("anim-compression-search.md").display());
+    if search_only {
+        return Ok(());
     }
     let gpu = gpu_context::GpuContext::new(&gpu_context::GpuOptions::default());
     let mut md = String::new();
@@ -651,6 +658,8 @@ pub fn run(out: &Path, only: Option<&str>) -> anyhow::Result<()> {
             let _ = writeln!(md, "Not drawn: no GPU adapter ({e}).");
         }
     }
+
+    md.push_str(&search);
 
     // Rate–distortion plot.
     let mut series = Vec::new();

@@ -103,25 +103,58 @@ pub fn choose_bits(
     let mut tried = 0;
     let mut encode = |qc: u8, qw: u8| -> Result<(Compressed, f64)> {
         tried += 1;
-        let p = CpcaParams {
-            bits_components: qc,
-            bits_weights: qw,
-            ..*params
-        };
-        let packed = Compressed::from_model(model, triangles, frame_rate, &p)?;
-        let da = Decoder::new(&packed).distortion(frames)?.da;
-        Ok((packed, da))
+        encode_measured(model, frames, triangles, frame_rate, params, qc, qw)
     };
     let (full, d0) = encode(MAX_BITS, MAX_BITS)?;
     // An exact model (d₀ ≈ 0) may still lose DA_FLOOR to quantization.
     let allowance = (d0 * tolerance).max(DA_FLOOR);
+    let best = fewest_bits_within(&mut encode, MAX_BITS, (full, d0), allowance)?;
+    Ok(BitsChoice {
+        compressed: best.0,
+        da_unquantized: d0,
+        da: best.1,
+        tried,
+    })
+}
+
+/// `model` encoded with q_c = `qc`, q_w = `qw` (c* from `params`) and the d_a of its decoded
+/// clip against `frames`.
+pub(crate) fn encode_measured(
+    model: &CpcaModel,
+    frames: &[Vec<Vec3>],
+    triangles: &[[u32; 3]],
+    frame_rate: f32,
+    params: &CpcaParams,
+    qc: u8,
+    qw: u8,
+) -> Result<(Compressed, f64)> {
+    let p = CpcaParams {
+        bits_components: qc,
+        bits_weights: qw,
+        ..*params
+    };
+    let packed = Compressed::from_model(model, triangles, frame_rate, &p)?;
+    let da = Decoder::new(&packed).distortion(frames)?.da;
+    Ok((packed, da))
+}
+
+/// The bisection of [`choose_bits`]: `top` is (the encoding at `ceiling` bits for both, its
+/// d_a d₀); returns the encoding with the fewest q_c whose d_a ≤ d₀ + allowance/2 with q_w at
+/// `ceiling`, then the fewest q_w with that q_c within d₀ + allowance, and its d_a.
+pub(crate) fn fewest_bits_within(
+    encode: &mut dyn FnMut(u8, u8) -> Result<(Compressed, f64)>,
+    ceiling: u8,
+    top: (Compressed, f64),
+    allowance: f64,
+) -> Result<(Compressed, f64)> {
+    let d0 = top.1;
     let bound = |share: f64| d0 + share * allowance;
-    // Fewest q_c with q_w = 32 within half the tolerance.
-    let mut pass = (MAX_BITS, full, d0);
-    let (mut lo, mut hi) = (MIN_BITS - 1, MAX_BITS); // lo: fails (or below range), hi: passes
+    // Fewest q_c with q_w at the ceiling within half the allowance.
+    let mut pass = (ceiling, top.0, d0);
+    let (mut lo, mut hi) = (MIN_BITS - 1, ceiling); // lo: fails (or below range), hi: passes
     while hi - lo > 1 {
         let mid = lo + (hi - lo) / 2;
-        let (packed, da) = encode(mid, MAX_BITS)?;
+        let (packed, da) = encode(mid, ceiling)?;
         if da <= bound(0.5) {
             hi = mid;
             pass = (mid, packed, da);
@@ -130,9 +163,9 @@ pub fn choose_bits(
         }
     }
     let qc = pass.0;
-    // Fewest q_w with that q_c within the whole tolerance; (qc, 32) already passes.
+    // Fewest q_w with that q_c within the whole allowance; (qc, ceiling) already passes.
     let mut best = (pass.1, pass.2);
-    let (mut lo, mut hi) = (MIN_BITS - 1, MAX_BITS);
+    let (mut lo, mut hi) = (MIN_BITS - 1, ceiling);
     while hi - lo > 1 {
         let mid = lo + (hi - lo) / 2;
         let (packed, da) = encode(qc, mid)?;
@@ -143,10 +176,5 @@ pub fn choose_bits(
             lo = mid;
         }
     }
-    Ok(BitsChoice {
-        compressed: best.0,
-        da_unquantized: d0,
-        da: best.1,
-        tried,
-    })
+    Ok(best)
 }

@@ -17,6 +17,7 @@
 //!    with the `gpu` feature (on by default), `GpuDecoder` does the same in a WGSL compute
 //!    shader, into a storage buffer that a renderer binds as its vertex buffer.
 //! 7. [`search_clusters`] raises k from 1 until a target d_a or file rate is met (§3.3.2);
+//!    [`search_rate_distortion`] searches k, c, c*, q_c and q_w together (issue #19);
 //!    [`choose_bits`] picks the fewest q_c, q_w bits that cost at most 1 % of the
 //!    unquantized d_a (`anim compress`'s default).
 //! 8. [`distortion`] gives d_a and d_f ("Error Measurement"); [`RateParams`] gives
@@ -83,6 +84,7 @@ mod gpu;
 mod metrics;
 mod model;
 mod quantize;
+mod rd;
 mod search;
 
 pub use bits::{BitsChoice, DA_FLOOR, DEFAULT_BITS_TOLERANCE, choose_bits};
@@ -97,6 +99,9 @@ pub use metrics::{
 };
 pub use model::{CpcaModel, trajectory_matrix};
 pub use quantize::{MAX_BITS, MIN_BITS, Quantized};
+pub use rd::{
+    RD_MAX_BITS, RD_MAX_COST, RD_MIN_BITS, RdLimits, RdPoint, RdSearch, search_rate_distortion,
+};
 pub use search::{ClusterSearch, RateTarget, SearchStep, search_clusters};
 
 use crate::error::{Result, invalid};

@@ -19,12 +19,13 @@ use std::time::Instant;
 
 use anim_pca::compress::{
     Compressed, CpcaModel, CpcaParams, DEFAULT_BITS_TOLERANCE, Decoder, Distortion, RateParams,
-    RateTarget, SearchStep, bpvf_from_file, search_clusters,
+    RateTarget, RdLimits, bpvf_from_file,
 };
 use glam::Vec3;
 
 pub use super::cpca_bits::AutoBits;
 use super::cpca_bits::choose_bits_for;
+pub use super::cpca_search::{SearchMode, SearchReport};
 use super::{anim_error, invalid};
 use cloth_vis::Error;
 
@@ -37,11 +38,11 @@ pub struct CompressRequest {
     pub clip: meshio::ClipSelector,
     /// k, c, c*, q_c, q_w, seed and the local-PCA limits.
     pub params: CpcaParams,
-    /// Search k = 1, 2, … for this target instead of using `params.clusters`
-    /// ([`search_clusters`], thesis §3.3.2).
+    /// Search for this target instead of using `params` as given: every parameter, or k
+    /// alone as the thesis does (§3.3.2), as `search` says.
     pub target: Option<RateTarget>,
-    /// Largest k the search tries.
-    pub k_max: usize,
+    /// How a target is searched.
+    pub search: SearchMode,
     /// Choose q_c and/or q_w ([`choose_bits`]) instead of taking them from `params`: the
     /// fewest bits that add at most [`DEFAULT_BITS_TOLERANCE`] to the unquantized d_a. Only
     /// without a target.
@@ -71,8 +72,8 @@ pub struct CompressSummary {
     /// Wall-clock seconds of [`Compressed::encode`] (fit, time PCA, quantization); with a
     /// target, of the whole search.
     pub encode_seconds: f64,
-    /// With a target: every k tried, and whether the chosen one meets the target.
-    pub search: Option<(Vec<SearchStep>, bool)>,
+    /// With a target: what the search did, and whether the chosen point meets the target.
+    pub search: Option<SearchReport>,
     /// With chosen bits: d_a of the unquantized model (32-bit codes) and the encodings tried.
     pub bits: Option<(f64, usize)>,
 }
@@ -89,14 +90,10 @@ impl CompressSummary {
     pub fn line(&self) -> String {
         let r = &self.rate;
         let (worst_frame, worst) = worst_frame(&self.distortion);
-        let search = match &self.search {
-            None => String::new(),
-            Some((steps, true)) => format!(" (target met after trying k = 1..={})", steps.len()),
-            Some((steps, false)) => format!(
-                " (target NOT met by any k in 1..={}; kept the closest)",
-                steps.len()
-            ),
-        };
+        let search = self
+            .search
+            .as_ref()
+            .map_or_else(String::new, SearchReport::text);
         let bits = match self.bits {
             None => String::new(),
             Some((d0, tried)) => format!(
@@ -340,23 +337,10 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
             None,
         ),
         Some(target) => {
-            let mut report = |s: &SearchStep| {
-                eprintln!(
-                    "  k = {:>3}: d_a = {:.4}, {:.3} bpvf (file), {:.2} s",
-                    s.k, s.da, s.bpvf, s.seconds
-                );
-            };
-            let found = search_clusters(
-                &clip.frames,
-                &clip.triangles,
-                clip.frame_rate,
-                &request.params,
-                target,
-                request.k_max,
-                &mut report,
-            )
-            .map_err(|e| anim_error(&request.input, e))?;
-            (found.compressed, Some((found.steps, found.reached)), None)
+            let (packed, report) =
+                super::cpca_search::search(&clip, &request.params, target, request.search)
+                    .map_err(|e| anim_error(&request.input, e))?;
+            (packed, Some(report), None)
         }
     };
     let encode_seconds = start.elapsed().as_secs_f64();
@@ -633,6 +617,15 @@ fn glb_frame_rate(rate: f32) -> f32 {
     }
 }
 
+/// `--search`: how a target is searched.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum SearchArg {
+    /// k, c, c*, q_c and q_w.
+    Full,
+    /// k alone (thesis §3.3.2).
+    K,
+}
+
 /// `cloth-vis anim compress`: the flags of a [`CompressRequest`].
 #[derive(clap::Args)]
 pub struct CompressArgs {
@@ -645,9 +638,9 @@ pub struct CompressArgs {
     /// k: vertex clusters (clamped to V).
     #[arg(long, default_value_t = CpcaParams::default().clusters)]
     clusters: usize,
-    /// c: eigentrajectories per cluster (clamped to 3F).
-    #[arg(long, default_value_t = CpcaParams::default().components)]
-    components: usize,
+    /// c: eigentrajectories per cluster (clamped to 3F) [default: 20].
+    #[arg(long, value_name = "C")]
+    components: Option<usize>,
     /// c*: components of the second PCA along time (default: none).
     #[arg(long, value_name = "C*")]
     time_components: Option<usize>,
@@ -661,16 +654,29 @@ pub struct CompressArgs {
     /// Seed of the local PCA (same seed, same file).
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Instead of --clusters: the smallest k (from 1) whose decoded clip has d_a ≤ X.
+    /// Instead of --clusters: the smallest file whose decoded clip has d_a ≤ X, searched over
+    /// k, c, c*, q_c and q_w (see --search).
     #[arg(long, value_name = "X", conflicts_with_all = ["clusters", "target_bpvf"])]
     target_da: Option<f64>,
-    /// Instead of --clusters: the k of lowest d_a whose file needs ≤ X bits per vertex
-    /// per frame.
+    /// Instead of --clusters: the lowest d_a whose file needs ≤ X bits per vertex per frame,
+    /// searched over k, c, c*, q_c and q_w (see --search).
     #[arg(long, value_name = "X", conflicts_with = "clusters")]
     target_bpvf: Option<f64>,
+    /// How a target is searched: `full` (k, c, c*, q_c, q_w; --components, --time-components,
+    /// --qc and --qw are searched, not used) or `k` (the thesis's §3.3.2 search: k = 1, 2, …
+    /// with the given c, c* and bits, 18 unless told).
+    #[arg(long, value_enum, default_value_t = SearchArg::Full)]
+    search: SearchArg,
     /// Largest k a --target-da/--target-bpvf search tries.
     #[arg(long, default_value_t = DEFAULT_K_MAX)]
     k_max: usize,
+    /// Largest c a full search tries (clamped to 3F).
+    #[arg(long, default_value_t = RdLimits::default().c_max)]
+    c_max: usize,
+    /// Most local-PCA fits a full search runs (its cost: each fit is one clustering of the
+    /// clip).
+    #[arg(long, default_value_t = RdLimits::default().max_fits)]
+    max_fits: usize,
     /// Output: FILE.cpca.
     #[arg(long)]
     out: PathBuf,
@@ -679,6 +685,21 @@ pub struct CompressArgs {
 impl CompressArgs {
     /// Encode and write; print the summary line.
     pub fn run(self) -> anyhow::Result<()> {
+        let fixed = [
+            ("--components", self.components.is_some()),
+            ("--time-components", self.time_components.is_some()),
+            ("--qc", self.qc.is_some()),
+            ("--qw", self.qw.is_some()),
+        ];
+        let targeted = self.target_da.is_some() || self.target_bpvf.is_some();
+        if let Some((flag, _)) = fixed.iter().find(|(_, given)| *given) {
+            if targeted && self.search == SearchArg::Full {
+                anyhow::bail!(
+                    "{flag} is searched with --target-da/--target-bpvf; drop it, or add \
+                     `--search k` to keep it fixed while k alone is searched (thesis §3.3.2)"
+                );
+            }
+        }
         let target = match (self.target_da, self.target_bpvf) {
             (Some(x), _) => Some(RateTarget::Distortion(x)),
             (None, Some(x)) => Some(RateTarget::Bpvf(x)),
@@ -689,7 +710,7 @@ impl CompressArgs {
             clip: self.clip.unwrap_or_default(),
             params: CpcaParams {
                 clusters: self.clusters,
-                components: self.components,
+                components: self.components.unwrap_or(CpcaParams::default().components),
                 time_components: self.time_components,
                 bits_components: self.qc.unwrap_or(anim_pca::compress::DEFAULT_BITS),
                 bits_weights: self.qw.unwrap_or(anim_pca::compress::DEFAULT_BITS),
@@ -697,7 +718,15 @@ impl CompressArgs {
                 ..Default::default()
             },
             target,
-            k_max: self.k_max,
+            search: match self.search {
+                SearchArg::Full => SearchMode::Full(RdLimits {
+                    k_max: self.k_max,
+                    c_max: self.c_max,
+                    max_fits: self.max_fits,
+                    ..RdLimits::default()
+                }),
+                SearchArg::K => SearchMode::Clusters { k_max: self.k_max },
+            },
             auto_bits: AutoBits {
                 components: self.qc.is_none(),
                 weights: self.qw.is_none(),

@@ -6,6 +6,7 @@ pub mod anim;
 pub mod btf;
 pub mod cpca;
 mod cpca_bits;
+mod cpca_search;
 pub mod inspect;
 pub mod jumpmap;
 pub mod parse;

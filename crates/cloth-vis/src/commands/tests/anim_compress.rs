@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use crate::commands::cpca::{
-    AutoBits, CompressRequest, DEFAULT_K_MAX, DecompressRequest, run_compress, run_decompress,
-    run_stats,
+    AutoBits, CompressRequest, DEFAULT_K_MAX, DecompressRequest, SearchMode, run_compress,
+    run_decompress, run_stats,
 };
 use anim_pca::compress::{Compressed, Decoder, bpvf_from_file};
 use glam::Vec3;
@@ -176,7 +176,9 @@ fn time_compression_and_obj_folder_output() {
         clip: meshio::ClipSelector::First,
         params,
         target: None,
-        k_max: DEFAULT_K_MAX,
+        search: SearchMode::Clusters {
+            k_max: DEFAULT_K_MAX,
+        },
         auto_bits: AutoBits::default(),
         out: cpca.clone(),
     })
@@ -243,7 +245,9 @@ fn time_compression_and_obj_folder_output() {
         clip: meshio::ClipSelector::First,
         params,
         target: None,
-        k_max: DEFAULT_K_MAX,
+        search: SearchMode::Clusters {
+            k_max: DEFAULT_K_MAX,
+        },
         auto_bits: AutoBits::default(),
         out: again.clone(),
     })
@@ -328,7 +332,9 @@ fn unsupported_outputs_are_refused_before_any_work() {
         clip: meshio::ClipSelector::First,
         params,
         target: None,
-        k_max: DEFAULT_K_MAX,
+        search: SearchMode::Clusters {
+            k_max: DEFAULT_K_MAX,
+        },
         auto_bits: AutoBits::default(),
         out: cpca.clone(),
     })
@@ -400,8 +406,9 @@ fn gpu() -> Option<gpu_context::GpuContext> {
 
 #[test]
 fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
-    // Two bars turning at different rates, c = 2: one cluster holds one rotation (a rank-2
-    // trajectory space) but not both; two clusters hold both exactly.
+    // `--search k`, the thesis's procedure. Two bars turning at different rates, c = 2: one
+    // cluster holds one rotation (a rank-2 trajectory space) but not both; two clusters hold
+    // both exactly.
     let dir = tempfile::tempdir().unwrap();
     let (input, frames) = write_clip(dir.path());
     let cpca = dir.path().join("s.cpca");
@@ -413,6 +420,8 @@ fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
         "2",
         "--target-da",
         "0.05",
+        "--search",
+        "k",
         "--out",
         text(&cpca),
     ]);
@@ -424,7 +433,7 @@ fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
         "{stderr}"
     );
     assert!(
-        stdout.contains("target met after trying k = 1..=2"),
+        stdout.contains("searched k = 1..=2; target met"),
         "{stdout}"
     );
     let packed = Compressed::from_bytes(&std::fs::read(&cpca).unwrap()).unwrap();
@@ -442,6 +451,8 @@ fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
         "2",
         "--target-bpvf",
         "0.5",
+        "--search",
+        "k",
         "--out",
         text(&tight),
     ]);
@@ -449,36 +460,61 @@ fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
     assert!(String::from_utf8_lossy(&out.stdout).contains("target NOT met"));
     let packed = Compressed::from_bytes(&std::fs::read(&tight).unwrap()).unwrap();
     assert_eq!(packed.clusters(), 1);
+}
 
-    // A generous budget buys the k of lowest d_a within it; the file respects it.
-    let roomy = dir.path().join("roomy.cpca");
-    let summary = run_compress(&CompressRequest {
+#[test]
+fn a_target_searches_every_parameter_by_default_and_keeps_the_budget() {
+    // Issue #19: `--target-bpvf` varied k alone and overshot budgets a better (k, c, q) met.
+    let dir = tempfile::tempdir().unwrap();
+    let (input, frames) = write_clip(dir.path());
+    let request = |search: SearchMode, out: &Path| CompressRequest {
         input: input.clone(),
         clip: meshio::ClipSelector::First,
-        params: anim_pca::compress::CpcaParams {
-            components: 2,
-            ..Default::default()
-        },
-        target: Some(anim_pca::compress::RateTarget::Bpvf(40.0)),
-        k_max: 4,
+        params: anim_pca::compress::CpcaParams::default(),
+        target: Some(anim_pca::compress::RateTarget::Bpvf(6.0)),
+        search,
         auto_bits: AutoBits::default(),
-        out: roomy.clone(),
-    })
+        out: out.to_owned(),
+    };
+    let (full_out, k_out) = (dir.path().join("full.cpca"), dir.path().join("k.cpca"));
+    let full = run_compress(&request(
+        SearchMode::Full(anim_pca::compress::RdLimits {
+            k_max: 4,
+            c_max: 8,
+            max_fits: 16,
+            ..Default::default()
+        }),
+        &full_out,
+    ))
     .unwrap();
-    let (steps, reached) = summary.search.clone().unwrap();
-    assert!(reached);
-    assert!(summary.bpvf_file() <= 40.0);
-    let best = steps
-        .iter()
-        .filter(|s| s.bpvf <= 40.0)
-        .map(|s| s.da)
-        .fold(f64::INFINITY, f64::min);
-    assert_eq!(summary.distortion.da, best);
+    let k_only = run_compress(&request(SearchMode::Clusters { k_max: 4 }, &k_out)).unwrap();
+    let report = full.search.clone().unwrap();
+    assert!(
+        report.full && report.reached && report.fits <= 16,
+        "{report:?}"
+    );
+    assert!(full.bpvf_file() <= 6.0, "{}", full.bpvf_file());
+    // The written file is the one measured.
+    let packed = Compressed::from_bytes(&std::fs::read(&full_out).unwrap()).unwrap();
+    let d = Decoder::new(&packed).distortion(&frames).unwrap();
+    assert_eq!(d.da, full.distortion.da);
+    // At least as good as the thesis's k search at the same budget (which may miss it).
+    if k_only.search.as_ref().unwrap().reached {
+        assert!(full.distortion.da <= k_only.distortion.da);
+    }
+    assert!(
+        full.line().contains("searched k, c, c*, q_c, q_w"),
+        "{}",
+        full.line()
+    );
 
     // Both targets at once, or a target beside --clusters, are refused by the parser.
+    // So are fixed parameters a full search would ignore (issue #19: they are searched).
     for extra in [
         &["--target-da", "1", "--target-bpvf", "4"][..],
         &["--target-da", "1", "--clusters", "3"][..],
+        &["--target-da", "1", "--components", "3"][..],
+        &["--target-bpvf", "4", "--qc", "12"][..],
     ] {
         let bad = dir.path().join("bad.cpca");
         let mut args = vec!["anim", "compress", text(&input), "--out", text(&bad)];
@@ -486,6 +522,13 @@ fn target_da_searches_k_from_one_and_stops_at_the_first_that_meets_it() {
         let out = cli(&args);
         assert!(!out.status.success(), "{extra:?} accepted");
         assert!(!bad.exists());
+        if extra.contains(&"--components") {
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                err.contains("--components") && err.contains("--search k"),
+                "{err}"
+            );
+        }
     }
 }
 
@@ -684,7 +727,9 @@ fn compress_into(input: &Path, cpca: &Path, clusters: usize, components: usize) 
             ..Default::default()
         },
         target: None,
-        k_max: DEFAULT_K_MAX,
+        search: SearchMode::Clusters {
+            k_max: DEFAULT_K_MAX,
+        },
         auto_bits: AutoBits::default(),
         out: cpca.to_owned(),
     })
@@ -710,7 +755,9 @@ fn default_bits_are_the_fewest_within_one_percent_of_the_unquantized_error() {
             clip: meshio::ClipSelector::First,
             params,
             target: None,
-            k_max: DEFAULT_K_MAX,
+            search: SearchMode::Clusters {
+                k_max: DEFAULT_K_MAX,
+            },
             auto_bits,
             out: dir.path().join(name),
         })

@@ -1,0 +1,130 @@
+//! `cloth-vis anim compress --target-da X | --target-bpvf X`: which search answers a target.
+//!
+//! By default the whole rate–distortion space is searched — k, c, c*, q_c and q_w
+//! ([`search_rate_distortion`], issue #19) — so a rate budget is met by the best file any of
+//! them gives. `--search k` keeps the thesis's own procedure (§3.3.2: raise k from 1 with c,
+//! c* and the bits fixed; [`search_clusters`]), for reproducing it.
+
+use anim_pca::compress::{
+    Compressed, CpcaParams, RateTarget, RdLimits, RdPoint, SearchStep, search_clusters,
+    search_rate_distortion,
+};
+
+/// How a target is searched.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SearchMode {
+    /// Every parameter: (k, c, c*, q_c, q_w), within these limits.
+    Full(RdLimits),
+    /// k = 1, 2, … up to `k_max` with c, c* and the bits of the request (thesis §3.3.2).
+    Clusters {
+        /// Largest k tried.
+        k_max: usize,
+    },
+}
+
+/// What a search did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SearchReport {
+    /// Whether it searched every parameter (else k alone).
+    pub full: bool,
+    /// Points judged: one per (k, c, c*) (or per k).
+    pub points: usize,
+    /// Local-PCA fits run.
+    pub fits: usize,
+    /// Encodings run.
+    pub encodings: usize,
+    /// Whether the chosen point meets the target (else it is the closest).
+    pub reached: bool,
+}
+
+impl SearchReport {
+    /// The summary line's note on the search.
+    pub fn text(&self) -> String {
+        let what = if self.full {
+            format!(
+                "searched k, c, c*, q_c, q_w: {} points, {} fits, {} encodings",
+                self.points, self.fits, self.encodings
+            )
+        } else {
+            format!("searched k = 1..={}", self.points)
+        };
+        if self.reached {
+            format!(" ({what}; target met)")
+        } else {
+            format!(" ({what}; target NOT met by any; kept the closest)")
+        }
+    }
+}
+
+/// Runs `mode` for `target` on `clip`; `params` gives the seed and local-PCA settings (and, for
+/// [`SearchMode::Clusters`], c, c* and the bits). Each point judged goes to stderr.
+pub(super) fn search(
+    clip: &meshio::Animation,
+    params: &CpcaParams,
+    target: RateTarget,
+    mode: SearchMode,
+) -> anim_pca::Result<(Compressed, SearchReport)> {
+    match mode {
+        SearchMode::Clusters { k_max } => {
+            let mut report = |s: &SearchStep| {
+                eprintln!(
+                    "  k = {:>3}: d_a = {:.4}, {:.3} bpvf (file), {:.2} s",
+                    s.k, s.da, s.bpvf, s.seconds
+                );
+            };
+            let found = search_clusters(
+                &clip.frames,
+                &clip.triangles,
+                clip.frame_rate,
+                params,
+                target,
+                k_max,
+                &mut report,
+            )?;
+            let report = SearchReport {
+                full: false,
+                points: found.steps.len(),
+                fits: found.steps.len(),
+                encodings: found.steps.len(),
+                reached: found.reached,
+            };
+            Ok((found.compressed, report))
+        }
+        SearchMode::Full(limits) => {
+            let mut report = |p: &RdPoint| eprintln!("  {}", point_text(p));
+            let found = search_rate_distortion(
+                &clip.frames,
+                &clip.triangles,
+                clip.frame_rate,
+                params,
+                target,
+                &limits,
+                &mut report,
+            )?;
+            let report = SearchReport {
+                full: true,
+                points: found.points.len(),
+                fits: found.fits,
+                encodings: found.encodings,
+                reached: found.reached(),
+            };
+            Ok((found.compressed, report))
+        }
+    }
+}
+
+/// One point of a full search, as printed while it runs.
+pub fn point_text(p: &RdPoint) -> String {
+    format!(
+        "k = {:>3}, c = {:>2}, c* = {:>3}, q_c = {:>2}, q_w = {:>2}: d_a = {:.4}, {:.3} bpvf{}",
+        p.clusters,
+        p.components,
+        p.time_components
+            .map_or_else(|| "-".to_owned(), |c| c.to_string()),
+        p.bits_components,
+        p.bits_weights,
+        p.da,
+        p.bpvf,
+        if p.meets { "" } else { " (misses the target)" }
+    )
+}
