@@ -117,3 +117,40 @@ fn zero_range_component() {
     assert!((0..3).any(|h| packed.eigentrajectory(0, h).step() == 0.0));
     assert!(da < 0.5, "{da}");
 }
+
+#[test]
+fn rate_distortion_search_on_a_static_clip_and_a_single_frame() {
+    // Issue #19's search on the degenerate clips: a clip that never moves (zero motion, every
+    // component zero-range) and a single frame. Both targets end finite and within budget.
+    use anim_pca::compress::{RateTarget, RdLimits, search_rate_distortion};
+    let frame: Vec<Vec3> = (0..40)
+        .map(|i| Vec3::new(i as f32, (i * i) as f32 * 0.01, 1.0))
+        .collect();
+    let limits = RdLimits {
+        k_max: 4,
+        c_max: 4,
+        max_fits: 12,
+        ..RdLimits::default()
+    };
+    for frames in [vec![frame.clone(); 20], vec![frame]] {
+        for target in [RateTarget::Bpvf(40.0), RateTarget::Distortion(0.5)] {
+            let found = search_rate_distortion(
+                &frames,
+                &[],
+                30.0,
+                &CpcaParams::default(),
+                target,
+                &limits,
+                &mut |_| {},
+            )
+            .unwrap();
+            let p = found.chosen;
+            assert!(p.da.is_finite() && p.bpvf.is_finite(), "{target:?}: {p:?}");
+            assert!(
+                found.reached(),
+                "{} frames, {target:?}: {p:?}",
+                frames.len()
+            );
+        }
+    }
+}
