@@ -25,7 +25,8 @@ use glam::Vec3;
 
 pub use super::cpca_bits::AutoBits;
 use super::cpca_bits::choose_bits_for;
-pub use super::cpca_search::{SearchMode, SearchReport};
+pub use super::cpca_figures::{cluster_strip, error_chart};
+pub use super::cpca_search::{FrontierPosition, SearchMode, SearchReport};
 use super::{anim_error, invalid};
 use cloth_vis::Error;
 
@@ -178,6 +179,8 @@ pub struct StatsSummary {
     pub file_bytes: usize,
     /// d_a and d_f of the file's frames against the original.
     pub distortion: Distortion,
+    /// With `--frontier`: the searched point at the file's rate, and how the file compares.
+    pub frontier: Option<FrontierPosition>,
 }
 
 impl StatsSummary {
@@ -201,7 +204,7 @@ impl StatsSummary {
         format!(
             "stats: V = {}, F = {}, k = {}, c = {}, c* = {}, q_c = {}, q_w = {}: bpvf eq. 3.16 = \
              {:.3}, eq. 3.17 = {:.3}, eq. 3.18 = {}, file = {:.3} ({} bytes); d_a = {:.4}, \
-             worst d_f = {:.4e} (frame {})",
+             worst d_f = {:.4e} (frame {}){}",
             r.vertices,
             r.frames,
             r.clusters,
@@ -216,7 +219,10 @@ impl StatsSummary {
             self.file_bytes,
             self.distortion.da,
             worst,
-            frame
+            frame,
+            self.frontier
+                .as_ref()
+                .map_or_else(String::new, FrontierPosition::text)
         )
     }
 }
@@ -468,6 +474,7 @@ pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
             cpca: cpca.to_owned(),
             clusters_png: None,
             error_plot: None,
+            frontier: false,
         },
         None,
     )
@@ -488,6 +495,8 @@ pub struct StatsRequest {
     pub clusters_png: Option<PathBuf>,
     /// Write d_f against the frame index (thesis Fig. 3.15) here, as an SVG chart.
     pub error_plot: Option<PathBuf>,
+    /// Also search the frontier at the file's rate ([`FrontierPosition`]).
+    pub frontier: bool,
 }
 
 /// Runs `stats` (bpvf, d_a, worst d_f) and writes the pictures `request` asks for. `gpu` is needed
@@ -554,55 +563,20 @@ pub fn run_stats_with_pictures(
         let chart = error_chart(&distortion, cpca);
         atomic_out::write_with(svg, |w| w.write_all(chart.as_bytes()))?;
     }
+    let frontier = request
+        .frontier
+        .then(|| {
+            let bpvf = bpvf_from_file(file_bytes, data.vertices(), data.frames());
+            FrontierPosition::measure(&clip, bpvf, distortion.da)
+        })
+        .transpose()
+        .map_err(|e| anim_error(original, e))?;
     Ok(StatsSummary {
         rate: data.rate(),
         file_bytes,
         distortion,
+        frontier,
     })
-}
-
-/// The decoded clip of `data` as a strip of frames, each vertex coloured by its cluster
-/// (thesis Figs. 3.12/3.13), named `what` in errors.
-///
-/// # Errors
-/// [`Error::Request`] when the file has no triangles; rendering errors.
-pub fn cluster_strip(
-    gpu: &gpu_context::GpuContext,
-    data: &Compressed,
-    what: &Path,
-) -> Result<image::RgbaImage, Error> {
-    let frames = Decoder::new(data).decode_all();
-    Ok(figures::strip::render_label_strip(
-        &gpu.device,
-        &gpu.queue,
-        &frames,
-        data.triangles(),
-        data.labels(),
-        data.clusters(),
-        what,
-    )?)
-}
-
-/// d_f per frame (thesis Fig. 3.15) as an SVG chart titled after `cpca`.
-pub fn error_chart(distortion: &Distortion, cpca: &Path) -> String {
-    use figures::chart::{Axis, Series, chart_svg};
-    let name = cpca
-        .file_name()
-        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    chart_svg(
-        &format!("d_f per frame, {name} (d_a = {:.4})", distortion.da),
-        ["frame", "d_f (position units)"],
-        [Axis::Linear, Axis::Linear],
-        &[Series {
-            label: "d_f".to_owned(),
-            points: distortion
-                .df
-                .iter()
-                .enumerate()
-                .map(|(f, &d)| (f as f64, d))
-                .collect(),
-        }],
-    )
 }
 
 /// Frame rate written to a `.glb` when the file's is not a positive number (the loaders'
@@ -779,6 +753,11 @@ pub struct StatsArgs {
     /// Also write d_f against the frame (Fig. 3.15) as an SVG chart.
     #[arg(long, value_name = "FILE.svg")]
     error_plot: Option<PathBuf>,
+    /// Also say where the file sits against the rate–distortion frontier: the full
+    /// `--target-bpvf` search at the file's own rate (about a minute on a 3,000-vertex,
+    /// 170-frame clip).
+    #[arg(long)]
+    frontier: bool,
 }
 
 impl StatsArgs {
@@ -794,6 +773,7 @@ impl StatsArgs {
             cpca: self.cpca,
             clusters_png: self.clusters_png,
             error_plot: self.error_plot,
+            frontier: self.frontier,
         };
         super::print_line(&run_stats_with_pictures(&request, gpu.as_ref())?.line())
     }

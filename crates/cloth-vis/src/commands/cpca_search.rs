@@ -128,3 +128,61 @@ pub fn point_text(p: &RdPoint) -> String {
         if p.meets { "" } else { " (misses the target)" }
     )
 }
+
+/// Where a `.cpca` file sits against the rate–distortion frontier (`anim stats --frontier`):
+/// the point the full search finds at the file's own rate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrontierPosition {
+    /// The file's bpvf: the search's budget.
+    pub budget: f64,
+    /// The searched point within that budget.
+    pub point: RdPoint,
+    /// The file's d_a over the searched point's d_a: above 1, the file spends its bits less
+    /// well than the frontier; at or below 1, it is on (or past) it.
+    pub ratio: f64,
+    /// Seconds the search took.
+    pub seconds: f64,
+}
+
+impl FrontierPosition {
+    /// Searches (k, c, c*, q_c, q_w) on `clip` within the file's rate `bpvf` and compares with
+    /// the file's `da`.
+    pub(super) fn measure(clip: &meshio::Animation, bpvf: f64, da: f64) -> anim_pca::Result<Self> {
+        let found = search_rate_distortion(
+            &clip.frames,
+            &clip.triangles,
+            clip.frame_rate,
+            &CpcaParams::default(),
+            RateTarget::Bpvf(bpvf),
+            &RdLimits::default(),
+            &mut |_| {},
+        )?;
+        Ok(Self {
+            budget: bpvf,
+            point: found.chosen,
+            ratio: da / found.chosen.da,
+            seconds: found.seconds,
+        })
+    }
+
+    /// The stats line's note.
+    pub fn text(&self) -> String {
+        let verdict = if self.ratio > 1.0 + 1e-9 {
+            format!(
+                "this file's d_a is {:.2}× the frontier's: `anim compress --target-bpvf {:.3}` \
+                 would do better",
+                self.ratio, self.budget
+            )
+        } else {
+            format!(
+                "this file is on the frontier (its d_a is {:.2}× the searched point's)",
+                self.ratio
+            )
+        };
+        format!(
+            "\nfrontier: at this file's rate the search reaches {} ({:.1} s); {verdict}",
+            point_text(&self.point),
+            self.seconds
+        )
+    }
+}

@@ -6,6 +6,7 @@ pub mod anim;
 pub mod btf;
 pub mod cpca;
 mod cpca_bits;
+mod cpca_figures;
 mod cpca_search;
 pub mod inspect;
 pub mod jumpmap;

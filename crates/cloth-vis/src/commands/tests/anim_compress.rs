@@ -533,6 +533,53 @@ fn a_target_searches_every_parameter_by_default_and_keeps_the_budget() {
 }
 
 #[test]
+fn stats_frontier_finds_a_file_compressed_with_too_few_components_off_the_frontier() {
+    // Issue #19 item 4: `anim stats --frontier` says where a file sits. One cluster of one
+    // component at 16 bits is a point the search's own grid holds, so the frontier at its
+    // rate is at least as good (ratio ≥ 1), and on two bars turning at their own rates much
+    // better.
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _) = write_clip(dir.path());
+    let cpca = dir.path().join("poor.cpca");
+    let out = cli(&[
+        "anim",
+        "compress",
+        text(&input),
+        "--clusters",
+        "1",
+        "--components",
+        "1",
+        "--qc",
+        "16",
+        "--qw",
+        "16",
+        "--out",
+        text(&cpca),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let summary = crate::commands::cpca::run_stats_with_pictures(
+        &crate::commands::cpca::StatsRequest {
+            clip: meshio::ClipSelector::First,
+            original: input.clone(),
+            cpca: cpca.clone(),
+            clusters_png: None,
+            error_plot: None,
+            frontier: true,
+        },
+        None,
+    )
+    .unwrap();
+    let position = summary.frontier.clone().unwrap();
+    assert!(position.point.meets && position.point.bpvf <= summary.bpvf_file());
+    assert!(position.ratio > 2.0, "{position:?}");
+    assert!(
+        summary.line().contains("would do better"),
+        "{}",
+        summary.line()
+    );
+}
+
+#[test]
 fn stats_draws_the_error_per_frame_and_the_clusters() {
     let dir = tempfile::tempdir().unwrap();
     let (input, frames) = write_clip(dir.path());
@@ -581,6 +628,7 @@ fn stats_draws_the_error_per_frame_and_the_clusters() {
         cpca: cpca.clone(),
         clusters_png: Some(dir.path().join("clusters.png")),
         error_plot: None,
+        frontier: false,
     };
     let e = crate::commands::cpca::run_stats_with_pictures(&request, Some(&gpu)).unwrap_err();
     assert!(e.to_string().contains("triangles"), "{e}");
