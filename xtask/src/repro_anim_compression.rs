@@ -410,7 +410,7 @@ pub fn run(out: &Path, only: Option<&str>, search_only: bool) -> anyhow::Result<
         sequences.retain(|s| s.name.contains(only));
         anyhow::ensure!(!sequences.is_empty(), "no sequence name contains {only:?}");
     }
-    let search = crate::repro_rd_search::section(&sequences)?;
+    let (search, searched) = crate::repro_rd_search::section(&sequences)?;
     atomic_out::write_bytes(&out.join("anim-compression-search.md"), search.as_bytes())?;
     eprintln!("wrote {}", out.join("anim-compression-search.md").display());
     if search_only {
@@ -678,8 +678,14 @@ pub fn run(out: &Path, only: Option<&str>, search_only: bool) -> anyhow::Result<
             });
         }
     }
+    for (name, points) in searched {
+        series.push(Series {
+            label: format!("{name} searched (--target-bpvf 2.0, 3.8, 7.4)"),
+            points,
+        });
+    }
     let svg = log_log_svg(
-        "Rate–distortion: bpvf against d_a (Pareto fronts)",
+        "Rate–distortion: bpvf against d_a (Pareto fronts; searched points)",
         "d_a",
         "bpvf (file)",
         &series,

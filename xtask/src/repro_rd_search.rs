@@ -77,8 +77,12 @@ fn grid(s: &Sequence, limits: &RdLimits) -> anyhow::Result<Vec<GridPoint>> {
     Ok(points?.into_iter().flatten().collect())
 }
 
-/// The section's markdown for `sequences`.
-pub fn section(sequences: &[Sequence]) -> anyhow::Result<String> {
+/// Per sequence, its name and searched points as (d_a, bpvf), one per budget.
+pub type Searched = Vec<(String, Vec<(f64, f64)>)>;
+
+/// The section's markdown for `sequences`, and their searched points for the
+/// rate–distortion plot.
+pub fn section(sequences: &[Sequence]) -> anyhow::Result<(String, Searched)> {
     let limits = RdLimits::default();
     let mut md = String::new();
     let _ = writeln!(
@@ -95,7 +99,9 @@ pub fn section(sequences: &[Sequence]) -> anyhow::Result<String> {
          |---|---|---|---|---|---|---|---|---|---|---|---|",
         limits.max_fits, limits.k_max, limits.c_max, limits.max_cost
     );
+    let mut searched = Vec::new();
     for s in sequences {
+        let mut points = Vec::new();
         let start = Instant::now();
         let grid = grid(s, &limits)?;
         let grid_s = start.elapsed().as_secs_f64();
@@ -110,6 +116,7 @@ pub fn section(sequences: &[Sequence]) -> anyhow::Result<String> {
                 &mut |_| {},
             )?;
             let p = found.chosen;
+            points.push((p.da, p.bpvf));
             let best = grid
                 .iter()
                 .filter(|g| g.bpvf <= budget)
@@ -146,6 +153,7 @@ pub fn section(sequences: &[Sequence]) -> anyhow::Result<String> {
                 s.name, p.da, p.bpvf, found.fits, found.seconds, best
             );
         }
+        searched.push((s.name.clone(), points));
     }
-    Ok(md)
+    Ok((md, searched))
 }
