@@ -198,11 +198,13 @@ fn load_file(path: &Path, scene: &Scene, index: usize) -> Result<Geometry, Error
         path.extension()
             .is_some_and(|e| e.eq_ignore_ascii_case(ext))
     };
-    let animation = if path.is_dir() || has_ext("npy") {
-        Some(meshio::load_animation(
-            path,
-            &meshio::AnimationOptions::default(),
-        )?)
+    let animation = if path.is_dir() || ["npy", "pc2", "mdd"].iter().any(|e| has_ext(e)) {
+        // Point caches take their triangles from the object's `topology` mesh.
+        let options = meshio::AnimationOptions {
+            topology: scene.topology_path(index),
+            ..meshio::AnimationOptions::default()
+        };
+        Some(meshio::load_animation(path, &options)?)
     } else if has_ext("glb") || has_ext("gltf") {
         // A glTF with an animation is posed at the requested frame; one without is static.
         meshio::load_animation(path, &meshio::AnimationOptions::default()).ok()

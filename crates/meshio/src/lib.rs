@@ -25,8 +25,9 @@
 //! | folder of numbered `.obj` frames | | ✓ (numeric order, parallel parse) |
 //! | `.gltf` / `.glb` | rest pose of the scene | skinning + morph targets sampled at a frame rate |
 //! | `.npy` `[F, V, 3]` f32/f64 | | ✓ (triangles from [`AnimationOptions::topology`]) |
+//! | `.pc2`, `.mdd` point caches | | ✓ (triangles from [`AnimationOptions::topology`]) |
 //!
-//! Output: [`write_npy_f32`]; [`write_glb`] (a [`GlbMesh`] with normals, linear float
+//! Output: [`write_npy_f32`]; [`write_pc2`], [`write_mdd`]; [`write_glb`] (a [`GlbMesh`] with normals, linear float
 //! `COLOR_0` and custom scalar attributes such as `_AO`); [`write_glb_animation`] (frames as
 //! morph targets driven by a `STEP` weights clip, read back by [`load_animation`]). All writers
 //! validate first and write atomically (through [`atomic_out`], whose errors arrive as
@@ -57,6 +58,7 @@ mod npy;
 mod obj;
 mod options;
 mod ply;
+mod pointcache;
 mod report;
 mod text;
 mod types;
@@ -76,6 +78,7 @@ pub use options::{
     AnimationOptions, ClipSelector, DEFAULT_FRAME_RATE, DEFAULT_MAX_FRAMES, LoadOptions,
     MAX_SAMPLED_BYTES, NormalWeighting,
 };
+pub use pointcache::{write_mdd, write_pc2};
 pub use report::{
     AttributeStatus, ClipInfo, DegenerateKind, DegenerateTriangle, LoadReport, SourceFormat,
 };
@@ -124,6 +127,7 @@ pub fn load_mesh(path: &Path, options: &LoadOptions) -> Result<(Mesh, LoadReport
 ///   [`AnimationOptions::frame_rate`] (skinning, morph targets, STEP/LINEAR/CUBICSPLINE).
 /// - OBJ folder: frames in numeric order of the number in the file name (`2.obj` before
 ///   `10.obj`); every frame must have frame 0's vertex count and face list.
+/// - `.pc2`/`.mdd` point caches: as `.npy` (an MDD's even frame times set the frame rate).
 /// - `.npy`: positions only; the triangles come from [`AnimationOptions::topology`]. Without
 ///   it the animation has no triangles and [`LoadReport::topology_missing`] is set (so that
 ///   point-only consumers can still use the data; anything needing normals must pass one).
@@ -143,6 +147,8 @@ pub fn load_animation(
     match extension(path).as_str() {
         "gltf" | "glb" => gltf::load_gltf_animation(path, options),
         "npy" => npy::load_npy_animation(path, options),
+        "pc2" => pointcache::load_pc2(path, options),
+        "mdd" => pointcache::load_mdd(path, options),
         "ply" | "obj" => {
             options.validate(path)?;
             let (mesh, report) = load_mesh(path, &LoadOptions::default())?;
@@ -157,7 +163,7 @@ pub fn load_animation(
         other => Err(MeshIoError::UnsupportedFormat {
             path: path.to_path_buf(),
             extension: other.to_string(),
-            expected: "animations load from .glb, .gltf, .npy, a folder of numbered .obj frames, or a single .ply/.obj",
+            expected: "animations load from .glb, .gltf, .npy, .pc2, .mdd, a folder of numbered .obj frames, or a single .ply/.obj",
         }),
     }
 }

@@ -372,6 +372,46 @@ fn npy_header(shape: &[usize]) -> Vec<u8> {
 
 /// Loads a `[F, V, 3]` array as an animation; triangles (and UVs) come from
 /// `options.topology`, or are empty with [`LoadReport::topology_missing`] set.
+/// Triangles and per-vertex UVs (when the mesh has them).
+pub(crate) type Connectivity = (Vec<[u32; 3]>, Option<Vec<glam::Vec2>>);
+
+/// The triangles and UVs of `options.topology` for a point-cache animation (`.npy`, PC2,
+/// MDD) of `vertex_count` vertices stored in `path`, noted in `report`; none (and
+/// `report.topology_missing`) without one.
+pub(crate) fn attach_topology(
+    path: &Path,
+    options: &AnimationOptions,
+    vertex_count: usize,
+    report: &mut LoadReport,
+) -> Result<Connectivity, MeshIoError> {
+    match &options.topology {
+        Some(topology) => {
+            let (mesh, _) = load_mesh(topology, &LoadOptions::default())?;
+            if mesh.vertex_count() != vertex_count {
+                return Err(MeshIoError::TopologyMismatch {
+                    path: path.to_path_buf(),
+                    topology: topology.clone(),
+                    topology_vertices: mesh.vertex_count(),
+                    animation_vertices: vertex_count,
+                });
+            }
+            report
+                .notes
+                .push(format!("triangles from {}", topology.display()));
+            Ok((mesh.triangles, mesh.uvs))
+        }
+        None => {
+            report.topology_missing = true;
+            report.notes.push(
+                "no topology given (AnimationOptions::topology, --topology MESH): the \
+                 animation has no triangles"
+                    .into(),
+            );
+            Ok((Vec::new(), None))
+        }
+    }
+}
+
 pub(crate) fn load_npy_animation(
     path: &Path,
     options: &AnimationOptions,
@@ -404,31 +444,7 @@ pub(crate) fn load_npy_animation(
         ));
     }
     let mut report = LoadReport::new(path, SourceFormat::Npy);
-    let (triangles, uvs) = match &options.topology {
-        Some(topology) => {
-            let (mesh, _) = load_mesh(topology, &LoadOptions::default())?;
-            if mesh.vertex_count() != vertex_count {
-                return Err(MeshIoError::TopologyMismatch {
-                    path: path.to_path_buf(),
-                    topology: topology.clone(),
-                    topology_vertices: mesh.vertex_count(),
-                    animation_vertices: vertex_count,
-                });
-            }
-            report
-                .notes
-                .push(format!("triangles from {}", topology.display()));
-            (mesh.triangles, mesh.uvs)
-        }
-        None => {
-            report.topology_missing = true;
-            report.notes.push(
-                "no topology given (AnimationOptions::topology): the animation has no triangles"
-                    .into(),
-            );
-            (Vec::new(), None)
-        }
-    };
+    let (triangles, uvs) = attach_topology(path, options, vertex_count, &mut report)?;
     let frames: Vec<Vec<Vec3>> = array
         .data
         .chunks_exact(vertex_count * 3)

@@ -25,6 +25,10 @@ pub enum SourceFormat {
     Glb,
     /// NumPy `.npy` array.
     Npy,
+    /// PC2 point cache (`.pc2`).
+    Pc2,
+    /// MDD point cache (`.mdd`).
+    Mdd,
 }
 
 /// Why a triangle is degenerate.

@@ -45,9 +45,11 @@ pub const RD_MAX_BITS: u8 = 24;
 /// The lowest bit count the search tries.
 pub const RD_MIN_BITS: u8 = 4;
 
-/// Default [`RdLimits::max_cost`]: 2·10⁹ multiply-adds per local-PCA iteration (about a
-/// second on one core; a fit takes tens of iterations).
-pub const RD_MAX_COST: f64 = 2e9;
+/// Default [`RdLimits::max_cost`]: 5·10⁸ multiply-adds per local-PCA iteration (a fraction
+/// of a second on one core; a fit takes tens of iterations). It leaves k·c ≤ 790 on the horse
+/// (8,431 vertices × 25 frames) and ≤ 320 on the chicken (3,030 × 170), and k·c ≤ 12 on
+/// BrainStem (34,159 × 400), whose larger models take minutes each.
+pub const RD_MAX_COST: f64 = 5e8;
 
 /// Bounds on a [`search_rate_distortion`] run.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,7 +64,7 @@ pub struct RdLimits {
     pub time_components: bool,
     /// Largest cost of one local-PCA iteration, V·k·c·3F multiply-adds, a (k, c) may have:
     /// larger ones are skipped (not fitted). This bounds the search's time on long, dense
-    /// clips (BrainStem, 34,159 vertices × 400 frames, reaches it at k·c ≈ 50).
+    /// clips (see [`RD_MAX_COST`]).
     pub max_cost: f64,
 }
 

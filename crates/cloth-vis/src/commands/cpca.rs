@@ -37,6 +37,8 @@ pub struct CompressRequest {
     pub input: PathBuf,
     /// Which of its glTF clips (the first unless told).
     pub clip: meshio::ClipSelector,
+    /// A mesh whose triangles (and UVs) a point-cache clip (`.npy`, `.pc2`, `.mdd`) takes.
+    pub topology: Option<PathBuf>,
     /// k, c, c*, q_c, q_w, seed and the local-PCA limits.
     pub params: CpcaParams,
     /// Search for this target instead of using `params` as given: every parameter, or k
@@ -315,8 +317,10 @@ pub fn read_cpca(path: &Path) -> Result<(Compressed, usize), Error> {
 pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error> {
     check_cpca_out(&request.out)?;
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
-    let (clip, _) =
-        meshio::load_animation(&request.input, &super::animation_options(&request.clip))?;
+    let (clip, _) = meshio::load_animation(
+        &request.input,
+        &super::animation_options(&request.clip, request.topology.as_deref()),
+    )?;
     let start = Instant::now();
     let auto = request.auto_bits;
     let (packed, search, bits) = match request.target {
@@ -471,6 +475,7 @@ pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
         &StatsRequest {
             original: original.to_owned(),
             clip: meshio::ClipSelector::First,
+            topology: None,
             cpca: cpca.to_owned(),
             clusters_png: None,
             error_plot: None,
@@ -487,6 +492,8 @@ pub struct StatsRequest {
     pub original: PathBuf,
     /// Which of its glTF clips (the one compressed; the first unless told).
     pub clip: meshio::ClipSelector,
+    /// A mesh whose triangles (and UVs) a point-cache clip (`.npy`, `.pc2`, `.mdd`) takes.
+    pub topology: Option<PathBuf>,
     /// The `.cpca` file.
     pub cpca: PathBuf,
     /// Write the decoded mesh coloured by cluster (thesis Figs. 3.12/3.13) here, as a PNG
@@ -534,7 +541,10 @@ pub fn run_stats_with_pictures(
         ));
     }
     let (data, file_bytes) = read_cpca(cpca)?;
-    let (clip, _) = meshio::load_animation(original, &super::animation_options(&request.clip))?;
+    let (clip, _) = meshio::load_animation(
+        original,
+        &super::animation_options(&request.clip, request.topology.as_deref()),
+    )?;
     let (f, v) = (
         clip.frames.len(),
         clip.frames.first().map_or(0, std::vec::Vec::len),
@@ -609,6 +619,10 @@ pub struct CompressArgs {
     /// formats hold one clip).
     #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
     clip: Option<meshio::ClipSelector>,
+    /// A mesh (.ply .obj .gltf .glb) whose triangles and UVs a point-cache clip (.npy, .pc2,
+    /// .mdd) takes; its vertex count must match.
+    #[arg(long, value_name = "MESH")]
+    topology: Option<PathBuf>,
     /// k: vertex clusters (clamped to V).
     #[arg(long, default_value_t = CpcaParams::default().clusters)]
     clusters: usize,
@@ -682,6 +696,7 @@ impl CompressArgs {
         let request = CompressRequest {
             input: self.input,
             clip: self.clip.unwrap_or_default(),
+            topology: self.topology,
             params: CpcaParams {
                 clusters: self.clusters,
                 components: self.components.unwrap_or(CpcaParams::default().components),
@@ -746,6 +761,10 @@ pub struct StatsArgs {
     /// The glTF animation to sample, by name or index (the one that was compressed; default: the first).
     #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
     clip: Option<meshio::ClipSelector>,
+    /// A mesh (.ply .obj .gltf .glb) whose triangles and UVs a point-cache clip (.npy, .pc2,
+    /// .mdd) takes; its vertex count must match.
+    #[arg(long, value_name = "MESH")]
+    topology: Option<PathBuf>,
 
     /// Also write the decoded mesh coloured by cluster (Figs. 3.12/3.13) as a PNG strip.
     #[arg(long, value_name = "FILE.png")]
@@ -770,6 +789,7 @@ impl StatsArgs {
         let request = StatsRequest {
             original: self.original,
             clip: self.clip.unwrap_or_default(),
+            topology: self.topology,
             cpca: self.cpca,
             clusters_png: self.clusters_png,
             error_plot: self.error_plot,

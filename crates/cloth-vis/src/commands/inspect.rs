@@ -12,7 +12,8 @@ use meshio::{AttributeStatus, LoadReport};
 /// Load a mesh or an animation and print what the loader found (counts, quirks, time).
 #[derive(clap::Args)]
 pub struct InspectArgs {
-    /// A mesh (.ply .obj .gltf .glb), an animation (.glb, .npy, a folder of numbered .obj).
+    /// A mesh (.ply .obj .gltf .glb), an animation (.glb, .npy, .pc2, .mdd, a folder of
+    /// numbered .obj).
     input: PathBuf,
     /// Treat a glTF as an animation: sample its first clip, as `visibility` and the `anim`
     /// commands do (default: the rest pose).
@@ -21,6 +22,10 @@ pub struct InspectArgs {
     /// The glTF animation to sample, by name or index (implies --animation).
     #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
     clip: Option<meshio::ClipSelector>,
+    /// A mesh whose triangles and UVs a point-cache clip (.npy, .pc2, .mdd) takes; its vertex
+    /// count must match.
+    #[arg(long, value_name = "MESH")]
+    topology: Option<PathBuf>,
     /// Print the loader's whole report (every field, every frame file) after the summary.
     #[arg(long)]
     debug: bool,
@@ -37,9 +42,15 @@ impl InspectArgs {
         };
         let mut out = std::io::stdout().lock();
         let start = Instant::now();
-        let animation = self.animation || self.clip.is_some() || input.is_dir() || has_ext("npy");
+        let animation = self.animation
+            || self.clip.is_some()
+            || input.is_dir()
+            || ["npy", "pc2", "mdd"].iter().any(|e| has_ext(e));
         let (lines, report) = if animation {
-            let options = super::animation_options(&self.clip.clone().unwrap_or_default());
+            let options = super::animation_options(
+                &self.clip.clone().unwrap_or_default(),
+                self.topology.as_deref(),
+            );
             let (anim, report) = meshio::load_animation(input, &options)?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
             let mut lines = vec![format!(
@@ -152,7 +163,10 @@ fn report_lines(report: &LoadReport) -> Vec<String> {
         ));
     }
     if report.topology_missing {
-        lines.push("no triangles: an .npy clip without a topology mesh".to_owned());
+        lines.push(
+            "no triangles: a point-cache clip (.npy, .pc2, .mdd) without --topology MESH"
+                .to_owned(),
+        );
     }
     if !report.skipped_keywords.is_empty() {
         let skipped: Vec<String> = report

@@ -62,6 +62,8 @@ pub struct JumpMapRequest {
     pub input: PathBuf,
     /// Which of the input's glTF clips (the first unless told; `--cell` files use their first).
     pub clip: meshio::ClipSelector,
+    /// A mesh whose triangles (and UVs) a point-cache clip (`.npy`, `.pc2`, `.mdd`) takes.
+    pub topology: Option<PathBuf>,
     /// Analysis parameters (c, c*, σ, σ*, q, q*, root motion).
     pub params: JumpMapParams,
     /// Cells, a cell schedule or a loop length.
@@ -267,8 +269,10 @@ pub fn run_jumpmap(
             Some((strip, gpu))
         }
     };
-    let (clip, _) =
-        meshio::load_animation(&request.input, &super::animation_options(&request.clip))?;
+    let (clip, _) = meshio::load_animation(
+        &request.input,
+        &super::animation_options(&request.clip, request.topology.as_deref()),
+    )?;
     // The generated run is held in memory before it is written: bound it by a named limit
     // rather than growing until the kernel kills the process (issue #12).
     let run_bytes = (request.frames as u128) * (clip.vertex_count() as u128) * 12;
@@ -607,6 +611,10 @@ pub struct JumpmapArgs {
     /// formats hold one clip).
     #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
     clip: Option<meshio::ClipSelector>,
+    /// A mesh (.ply .obj .gltf .glb) whose triangles and UVs a point-cache clip (.npy, .pc2,
+    /// .mdd) takes; its vertex count must match.
+    #[arg(long, value_name = "MESH")]
+    topology: Option<PathBuf>,
     /// A further clip of the same mesh, analysed as the next cell (motion control,
     /// thesis §3.2.2); repeat for more cells. The input is cell 0.
     #[arg(long, value_name = "CLIP")]
@@ -707,6 +715,7 @@ impl JumpmapArgs {
         JumpMapRequest {
             input: self.input,
             clip: self.clip.unwrap_or_default(),
+            topology: self.topology,
             params: JumpMapParams {
                 components: self.components,
                 velocity_components: self.velocity_components,

@@ -78,9 +78,13 @@ pub fn refuse_overwriting_input(
 }
 
 /// Loader options for an animation input: the glTF clip `--clip` names, defaults otherwise.
-pub fn animation_options(clip: &meshio::ClipSelector) -> meshio::AnimationOptions {
+pub fn animation_options(
+    clip: &meshio::ClipSelector,
+    topology: Option<&std::path::Path>,
+) -> meshio::AnimationOptions {
     meshio::AnimationOptions {
         clip: clip.clone(),
+        topology: topology.map(std::path::Path::to_owned),
         ..meshio::AnimationOptions::default()
     }
 }

@@ -70,6 +70,8 @@ pub const GLB_UNUSED_AO: f32 = -1.0;
 pub struct VisibilityRequest {
     /// A mesh, or an animation (folder of numbered OBJ, `.npy`, animated glTF).
     pub input: PathBuf,
+    /// A mesh whose triangles a point-cache input (`.npy`, `.pc2`, `.mdd`) takes.
+    pub topology: Option<PathBuf>,
     /// Lightsphere level.
     pub level: u32,
     /// Backend; `None` = depth on a hardware GPU, cpu otherwise.
@@ -106,6 +108,7 @@ impl VisibilityRequest {
     pub fn new(input: PathBuf) -> Self {
         Self {
             input,
+            topology: None,
             level: 3,
             backend: None,
             depth_resolution: occlusion_gpu::DEFAULT_DEPTH_RESOLUTION,
@@ -276,6 +279,14 @@ const MAX_EXPOSURE_EV: f32 = 64.0;
 /// pixels; the backdrop when an environment is given, else black).
 fn one_object_scene(request: &VisibilityRequest) -> Result<Scene, Error> {
     let mut scene = Scene::one_object(&request.input, "cloth-vis visibility")?;
+    if let Some(topology) = &request.topology {
+        scene.objects[0].topology = Some(
+            topology
+                .to_str()
+                .ok_or_else(|| invalid(topology, "the path is not valid UTF-8".to_owned()))?
+                .to_owned(),
+        );
+    }
     scene.lighting.level = request.level;
     scene.visibility.backend = match request.backend {
         None => VisibilityBackendDesc::Auto,
@@ -321,7 +332,8 @@ pub fn run_visibility(
     if object.triangles.is_empty() {
         return Err(invalid(
             input,
-            "the input has no triangles (an .npy animation carries none); pass a mesh instead"
+            "the input has no triangles (a point cache — .npy, .pc2, .mdd — carries none): \
+             add --topology MESH, a mesh with the same vertices"
                 .to_owned(),
         ));
     }
@@ -537,9 +549,13 @@ fn write_ply(
 /// `cloth-vis visibility`: the flags of a [`VisibilityRequest`].
 #[derive(clap::Args)]
 pub struct VisibilityArgs {
-    /// A mesh (.ply .obj .gltf .glb), an animation (folder of numbered .obj, .npy, .glb) or
-    /// synth:cloth (the demo's simulated drape).
+    /// A mesh (.ply .obj .gltf .glb), an animation (folder of numbered .obj, .glb; point
+    /// caches .npy, .pc2, .mdd with --topology) or synth:cloth (the demo's simulated drape).
     input: PathBuf,
+    /// A mesh (.ply .obj .gltf .glb) whose triangles a point-cache input (.npy, .pc2, .mdd)
+    /// takes; its vertex count must match.
+    #[arg(long, value_name = "MESH")]
+    topology: Option<PathBuf>,
     /// Lightsphere level s (k = 2 + 4^(s+1) directions).
     #[arg(long, default_value_t = 3)]
     level: u32,
@@ -625,6 +641,7 @@ impl VisibilityArgs {
         };
         let request = VisibilityRequest {
             input: self.input,
+            topology: self.topology,
             level: self.level,
             backend,
             depth_resolution: self.depth_res,

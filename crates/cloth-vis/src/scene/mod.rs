@@ -7,6 +7,7 @@
 //! [[object]]
 //! name = "cloth"
 //! source = "synth:cloth"        # or a mesh (.ply .obj .gltf .glb) or an animation
+//!                               # (a point cache .npy .pc2 .mdd also needs topology = "mesh.obj")
 //! frame = -1                    # animation frame; negative counts from the end
 //! albedo = [0.75, 0.2, 0.15]
 //! two_sided = true
@@ -111,6 +112,10 @@ pub struct ObjectDesc {
     pub name: String,
     /// `synth:cloth`, `synth:cloth-obstacle`, or a path to a mesh or animation.
     pub source: String,
+    /// A mesh whose triangles (and UVs) a point-cache `source` (`.npy`, `.pc2`, `.mdd`)
+    /// takes; its vertex count must match.
+    #[serde(default)]
+    pub topology: Option<String>,
     /// Animation frame to show; negative counts from the end (-1 = last).
     #[serde(default)]
     pub frame: i64,
@@ -375,6 +380,7 @@ impl Scene {
         scene.objects.push(ObjectDesc {
             name: scene.name.clone(),
             source: source.to_owned(),
+            topology: None,
             frame: 0,
             albedo: [1.0; 3],
             two_sided: false,
@@ -445,6 +451,14 @@ impl Scene {
             )),
             None => Ok(GeometrySource::File(self.base_dir.join(&object.source))),
         }
+    }
+
+    /// The `topology` mesh of object `index`, resolved against the scene's folder.
+    pub fn topology_path(&self, index: usize) -> Option<PathBuf> {
+        self.objects[index]
+            .topology
+            .as_ref()
+            .map(|t| self.base_dir.join(t))
     }
 
     /// Resolve the BTF material's source.
@@ -610,6 +624,14 @@ impl Scene {
                     return Err(
                         self.invalid(&key("source"), format!("{} does not exist", path.display()))
                     );
+                }
+            }
+            if let Some(path) = self.topology_path(i) {
+                if !path.exists() {
+                    return Err(self.invalid(
+                        &key("topology"),
+                        format!("{} does not exist", path.display()),
+                    ));
                 }
             }
         }

@@ -174,6 +174,7 @@ fn time_compression_and_obj_folder_output() {
     let summary = run_compress(&CompressRequest {
         input: input.clone(),
         clip: meshio::ClipSelector::First,
+        topology: None,
         params,
         target: None,
         search: SearchMode::Clusters {
@@ -243,6 +244,7 @@ fn time_compression_and_obj_folder_output() {
     run_compress(&CompressRequest {
         input,
         clip: meshio::ClipSelector::First,
+        topology: None,
         params,
         target: None,
         search: SearchMode::Clusters {
@@ -330,6 +332,7 @@ fn unsupported_outputs_are_refused_before_any_work() {
     run_compress(&CompressRequest {
         input,
         clip: meshio::ClipSelector::First,
+        topology: None,
         params,
         target: None,
         search: SearchMode::Clusters {
@@ -470,6 +473,7 @@ fn a_target_searches_every_parameter_by_default_and_keeps_the_budget() {
     let request = |search: SearchMode, out: &Path| CompressRequest {
         input: input.clone(),
         clip: meshio::ClipSelector::First,
+        topology: None,
         params: anim_pca::compress::CpcaParams::default(),
         target: Some(anim_pca::compress::RateTarget::Bpvf(6.0)),
         search,
@@ -560,6 +564,7 @@ fn stats_frontier_finds_a_file_compressed_with_too_few_components_off_the_fronti
     let summary = crate::commands::cpca::run_stats_with_pictures(
         &crate::commands::cpca::StatsRequest {
             clip: meshio::ClipSelector::First,
+            topology: None,
             original: input.clone(),
             cpca: cpca.clone(),
             clusters_png: None,
@@ -624,6 +629,7 @@ fn stats_draws_the_error_per_frame_and_the_clusters() {
     // The npy clip has no triangles: a cluster picture of it is refused by name.
     let request = crate::commands::cpca::StatsRequest {
         clip: meshio::ClipSelector::First,
+        topology: None,
         original: input.clone(),
         cpca: cpca.clone(),
         clusters_png: Some(dir.path().join("clusters.png")),
@@ -769,6 +775,7 @@ fn compress_into(input: &Path, cpca: &Path, clusters: usize, components: usize) 
     run_compress(&CompressRequest {
         input: input.to_owned(),
         clip: meshio::ClipSelector::First,
+        topology: None,
         params: anim_pca::compress::CpcaParams {
             clusters,
             components,
@@ -801,6 +808,7 @@ fn default_bits_are_the_fewest_within_one_percent_of_the_unquantized_error() {
         run_compress(&CompressRequest {
             input: input.clone(),
             clip: meshio::ClipSelector::First,
+            topology: None,
             params,
             target: None,
             search: SearchMode::Clusters {

@@ -57,6 +57,7 @@ fn request(input: PathBuf, out: PathBuf) -> JumpMapRequest {
     JumpMapRequest {
         input,
         clip: meshio::ClipSelector::First,
+        topology: None,
         params: JumpMapParams::default(),
         control: PlayControl::default(),
         playback: PlaybackParams {

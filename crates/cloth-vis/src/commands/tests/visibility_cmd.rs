@@ -192,3 +192,72 @@ fn a_machine_without_vulkan_gets_an_error_not_a_panic() {
         assert!(!npy.exists() && !png.exists(), "nothing is written");
     }
 }
+
+/// Issue #18: point caches (`.pc2`, `.mdd`, `.npy`) are visibility inputs once `--topology`
+/// gives their triangles; a_i per frame equals that of the same frames as an OBJ folder, bit
+/// for bit. Without a topology the refusal names the flag.
+#[test]
+fn point_caches_with_a_topology_mesh_match_the_obj_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = grid_obj(dir.path());
+    let (rest, _) = meshio::load_mesh(&mesh, &meshio::LoadOptions::default()).unwrap();
+    // Three frames: the grid folding up about its middle row.
+    let frames: Vec<Vec<glam::Vec3>> = (0..3)
+        .map(|f| {
+            rest.positions
+                .iter()
+                .map(|p| {
+                    let lift = if p.x > 0.6 {
+                        (p.x - 0.5) * 0.4 * f as f32
+                    } else {
+                        0.0
+                    };
+                    *p + glam::Vec3::Y * lift
+                })
+                .collect()
+        })
+        .collect();
+    let folder = dir.path().join("frames");
+    std::fs::create_dir(&folder).unwrap();
+    let faces: String = std::fs::read_to_string(&mesh)
+        .unwrap()
+        .lines()
+        .filter(|l| l.starts_with("f "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    for (f, frame) in frames.iter().enumerate() {
+        let mut text: String = frame
+            .iter()
+            .map(|p| format!("v {} {} {}\n", p.x, p.y, p.z))
+            .collect();
+        text.push_str(&faces);
+        std::fs::write(folder.join(format!("{}.obj", f + 1)), text).unwrap();
+    }
+    // The caches hold the positions the OBJ text round-trips to.
+    let (obj_clip, _) =
+        meshio::load_animation(&folder, &meshio::AnimationOptions::default()).unwrap();
+    let pc2 = dir.path().join("clip.pc2");
+    let mdd = dir.path().join("clip.mdd");
+    meshio::write_pc2(&pc2, &obj_clip.frames, 0.0, 1.0).unwrap();
+    meshio::write_mdd(&mdd, &obj_clip.frames, 30.0).unwrap();
+    let run = |input: &std::path::Path, topology: Option<&std::path::Path>, name: &str| {
+        let out = dir.path().join(name);
+        let mut r = request(input.to_owned(), Some(out.clone()));
+        r.topology = topology.map(std::path::Path::to_owned);
+        run_visibility(&r, None).map(|_| meshio::read_npy_f32(&out).unwrap())
+    };
+    let reference = run(&folder, None, "obj.npy").unwrap();
+    assert_eq!(reference.shape, vec![3, 26]);
+    for (cache, name) in [(&pc2, "pc2.npy"), (&mdd, "mdd.npy")] {
+        let got = run(cache, Some(&mesh), name).unwrap();
+        assert_eq!(got.shape, reference.shape);
+        let same = got
+            .data
+            .iter()
+            .zip(&reference.data)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        assert!(same, "{}", cache.display());
+    }
+    let message = run(&pc2, None, "none.npy").unwrap_err().to_string();
+    assert!(message.contains("--topology"), "{message}");
+}
