@@ -8,7 +8,7 @@
 #   RUNS=1000000 fuzz/run.sh 3600 hdr    (stop each target after RUNS executions instead)
 #
 # Besides the shared data, fuzz/seeds/<target>/ holds small valid files of our own formats
-# (.cpca, .btfpca, .npy, a morph-target .gltf, a BTF image) that no real data set provides.
+# (.cpca, .btfpca, .npy, .pc2, .mdd, a morph-target .gltf, a BTF image) that no real data set provides.
 #
 # Needs `cargo install cargo-fuzz`. Runs on the stable toolchain through RUSTC_BOOTSTRAP=1.
 set -euo pipefail
@@ -17,7 +17,7 @@ seconds=${1:?usage: fuzz/run.sh SECONDS [TARGET...]}
 shift
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-  targets=(ply obj obj_frames gltf glb npy hdr exr cpca btfpca btf_image scene_toml)
+  targets=(ply obj obj_frames gltf glb npy pc2 mdd hdr exr cpca btfpca btf_image scene_toml)
 fi
 shared=../shared/data
 seed() { # seed TARGET FILES...
@@ -37,6 +37,8 @@ seed obj_frames data/bad/mismatched_frames/1.obj
 seed gltf
 seed glb "$shared"/anim/gltf/Fox.glb "$shared"/anim/gltf/CesiumMan.glb
 seed npy
+seed pc2
+seed mdd
 seed hdr "$shared"/env/kiara_1_dawn_1k.hdr
 seed exr
 seed cpca

@@ -21,6 +21,8 @@ pub const TARGETS: &[&str] = &[
     "gltf",
     "glb",
     "npy",
+    "pc2",
+    "mdd",
     "hdr",
     "exr",
     "cpca",
@@ -45,6 +47,8 @@ pub fn run(target: &str, data: &[u8]) {
             animation(data, "scene.glb");
         }
         "npy" => animation(data, "frames.npy"),
+        "pc2" => animation(data, "cache.pc2"),
+        "mdd" => animation(data, "cache.mdd"),
         "hdr" => environment(data, "sky.hdr"),
         "exr" => environment(data, "sky.exr"),
         "cpca" => {

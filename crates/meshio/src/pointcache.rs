@@ -179,7 +179,7 @@ pub(crate) fn load_mdd(
         .unwrap_or(u64::MAX);
     let mut report = LoadReport::new(path, SourceFormat::Mdd);
     // Blender's exporter writes its rest pose as one extra block before the frames.
-    let skip = if len == needed + block {
+    let skip = if len.checked_sub(block) == Some(needed) {
         report.notes.push(
             "one extra block of positions before the frames (Blender's rest pose) skipped".into(),
         );

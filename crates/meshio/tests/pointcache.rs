@@ -133,6 +133,12 @@ fn headers_the_bytes_cannot_back_are_refused_before_allocating() {
             [i32::MAX.to_be_bytes(), 1i32.to_be_bytes()].concat(),
             "truncated",
         ),
+        // 12·P·F beyond u64: the size check itself must not overflow.
+        (
+            "both.mdd",
+            [i32::MAX.to_be_bytes(), i32::MAX.to_be_bytes()].concat(),
+            "truncated",
+        ),
     ] {
         let p = write(name, &bytes);
         let message = load_animation(&p, &AnimationOptions::default())
