@@ -209,6 +209,30 @@ fn a_property_less_element_and_empty_npy_frames_stay_within_the_limit() {
     assert!(peak < PEAK_LIMIT, "peak {} MB", peak >> 20);
 }
 
+#[test]
+fn point_cache_headers_claiming_exabytes_stay_within_a_kilobyte() {
+    let _alone = alone();
+    // PC2 and MDD headers of 2^31 − 1 points × 2^31 − 1 frames (5.5·10¹⁹ bytes, beyond u64):
+    // refused by the size check before anything of that size is asked for.
+    let dir = tempfile::tempdir().unwrap();
+    let mut pc2 = b"POINTCACHE2\0".to_vec();
+    for v in [1i32, i32::MAX] {
+        pc2.extend_from_slice(&v.to_le_bytes());
+    }
+    pc2.extend_from_slice(&0f32.to_le_bytes());
+    pc2.extend_from_slice(&1f32.to_le_bytes());
+    pc2.extend_from_slice(&i32::MAX.to_le_bytes());
+    let mdd = [i32::MAX.to_be_bytes(), i32::MAX.to_be_bytes()].concat();
+    for (name, bytes) in [("huge.pc2", pc2), ("huge.mdd", mdd)] {
+        let path = write(dir.path(), name, bytes);
+        let (result, peak) = peak_of(|| load_animation(&path, &AnimationOptions::default()));
+        let message = result.unwrap_err().to_string();
+        assert!(message.contains(name), "{message}");
+        eprintln!("{name}: refused at a peak of {peak} bytes");
+        assert!(peak < 1 << 10, "{name}: peak {peak} bytes");
+    }
+}
+
 /// A one-triangle glTF whose buffer is the file `uri`.
 fn gltf_with_uri(dir: &Path, uri: &str) -> PathBuf {
     let doc = json!({
