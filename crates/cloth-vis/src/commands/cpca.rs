@@ -26,6 +26,7 @@ use glam::Vec3;
 pub use super::cpca_bits::AutoBits;
 use super::cpca_bits::choose_bits_for;
 pub use super::cpca_figures::{cluster_strip, error_chart};
+use super::cpca_search::SearchArg;
 pub use super::cpca_search::{FrontierPosition, SearchMode, SearchReport};
 use super::{anim_error, invalid};
 use cloth_vis::Error;
@@ -601,15 +602,6 @@ fn glb_frame_rate(rate: f32) -> f32 {
     }
 }
 
-/// `--search`: how a target is searched.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-enum SearchArg {
-    /// k, c, c*, q_c and q_w.
-    Full,
-    /// k alone (thesis §3.3.2).
-    K,
-}
-
 /// `cloth-vis anim compress`: the flags of a [`CompressRequest`].
 #[derive(clap::Args)]
 pub struct CompressArgs {
@@ -673,21 +665,24 @@ pub struct CompressArgs {
 impl CompressArgs {
     /// Encode and write; print the summary line.
     pub fn run(self) -> anyhow::Result<()> {
-        let fixed = [
-            ("--components", self.components.is_some()),
-            ("--time-components", self.time_components.is_some()),
-            ("--qc", self.qc.is_some()),
-            ("--qw", self.qw.is_some()),
-        ];
-        let targeted = self.target_da.is_some() || self.target_bpvf.is_some();
-        if let Some((flag, _)) = fixed.iter().find(|(_, given)| *given) {
-            if targeted && self.search == SearchArg::Full {
-                anyhow::bail!(
-                    "{flag} is searched with --target-da/--target-bpvf; drop it, or add \
-                     `--search k` to keep it fixed while k alone is searched (thesis §3.3.2)"
-                );
-            }
-        }
+        super::cpca_search::check_flags(
+            [
+                ("--target-da", self.target_da),
+                ("--target-bpvf", self.target_bpvf),
+            ],
+            [
+                ("--k-max", self.k_max),
+                ("--c-max", self.c_max),
+                ("--max-fits", self.max_fits),
+            ],
+            [
+                ("--components", self.components.is_some()),
+                ("--time-components", self.time_components.is_some()),
+                ("--qc", self.qc.is_some()),
+                ("--qw", self.qw.is_some()),
+            ],
+            self.search,
+        )?;
         let target = match (self.target_da, self.target_bpvf) {
             (Some(x), _) => Some(RateTarget::Distortion(x)),
             (None, Some(x)) => Some(RateTarget::Bpvf(x)),

@@ -186,3 +186,41 @@ impl FrontierPosition {
         )
     }
 }
+
+/// `--search`: how a target is searched.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(super) enum SearchArg {
+    /// k, c, c*, q_c and q_w.
+    Full,
+    /// k alone (thesis §3.3.2).
+    K,
+}
+
+/// Refuses search flags no search can use, naming the flag, before the clip is loaded: a
+/// target that is not positive and finite, a limit of 0, and a parameter fixed on the command
+/// line (`fixed`: flag, given) that a full search would search instead.
+pub(super) fn check_flags(
+    targets: [(&str, Option<f64>); 2],
+    limits: [(&str, usize); 3],
+    fixed: [(&str, bool); 4],
+    search: SearchArg,
+) -> anyhow::Result<()> {
+    for (flag, value) in targets {
+        if let Some(x) = value.filter(|x| !(x.is_finite() && *x > 0.0)) {
+            anyhow::bail!("{flag} {x}: a target must be a positive finite number");
+        }
+    }
+    if let Some((flag, _)) = limits.iter().find(|(_, n)| *n == 0) {
+        anyhow::bail!("{flag} 0: a search limit must be at least 1");
+    }
+    let targeted = targets.iter().any(|(_, t)| t.is_some());
+    if let Some((flag, _)) = fixed.iter().find(|(_, given)| *given) {
+        if targeted && search == SearchArg::Full {
+            anyhow::bail!(
+                "{flag} is searched with --target-da/--target-bpvf; drop it, or add \
+                 `--search k` to keep it fixed while k alone is searched (thesis §3.3.2)"
+            );
+        }
+    }
+    Ok(())
+}

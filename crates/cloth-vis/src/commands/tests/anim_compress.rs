@@ -519,6 +519,9 @@ fn a_target_searches_every_parameter_by_default_and_keeps_the_budget() {
         &["--target-da", "1", "--clusters", "3"][..],
         &["--target-da", "1", "--components", "3"][..],
         &["--target-bpvf", "4", "--qc", "12"][..],
+        &["--target-bpvf", "0"][..],
+        &["--target-da", "nan"][..],
+        &["--target-bpvf", "4", "--max-fits", "0"][..],
     ] {
         let bad = dir.path().join("bad.cpca");
         let mut args = vec!["anim", "compress", text(&input), "--out", text(&bad)];
