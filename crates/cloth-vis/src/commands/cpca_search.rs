@@ -116,18 +116,23 @@ pub(super) fn search(
 /// One point of a full search, as printed while it runs.
 pub fn point_text(p: &RdPoint) -> String {
     format!(
-        "k = {:>3}, c = {:>2}, c* = {:>3}, q_c = {:>2}, q_w = {:>2}: d_a = {:.4}, {:.3} bpvf{}",
+        "k = {:>3}, c = {:>2}, c* = {:>3}, q_c = {:>2}, q_w = {:>2}: d_a = {}, {:.3} bpvf{}",
         p.clusters,
         p.components,
         p.time_components
             .map_or_else(|| "-".to_owned(), |c| c.to_string()),
         p.bits_components,
         p.bits_weights,
-        p.da,
+        da_text(p.da),
         p.bpvf,
         if p.meets { "" } else { " (misses the target)" }
     )
 }
+
+/// How far above the searched point's d_a a file may be and still count as on the frontier:
+/// 5 % (the search samples the bits and k, c on a lattice, so it is itself a few percent off
+/// the true frontier).
+pub const FRONTIER_SLACK: f64 = 0.05;
 
 /// Where a `.cpca` file sits against the rate–distortion frontier (`anim stats --frontier`):
 /// the point the full search finds at the file's own rate.
@@ -167,7 +172,7 @@ impl FrontierPosition {
 
     /// The stats line's note.
     pub fn text(&self) -> String {
-        let verdict = if self.ratio > 1.0 + 1e-9 {
+        let verdict = if self.ratio > 1.0 + FRONTIER_SLACK {
             format!(
                 "this file's d_a is {:.2}× the frontier's: `anim compress --target-bpvf {:.3}` \
                  would do better",
@@ -175,8 +180,10 @@ impl FrontierPosition {
             )
         } else {
             format!(
-                "this file is on the frontier (its d_a is {:.2}× the searched point's)",
-                self.ratio
+                "this file is on the frontier (its d_a is {:.2}× the searched point's, within \
+                 {:.0} %)",
+                self.ratio,
+                100.0 * FRONTIER_SLACK
             )
         };
         format!(
@@ -223,4 +230,14 @@ pub(super) fn check_flags(
         }
     }
     Ok(())
+}
+
+/// d_a with four significant decimals, in scientific notation below 0.01 (exact clips reach
+/// 10⁻⁵).
+fn da_text(da: f64) -> String {
+    if da != 0.0 && da.abs() < 0.01 {
+        format!("{da:.3e}")
+    } else {
+        format!("{da:.4}")
+    }
 }
