@@ -117,6 +117,9 @@ pub struct RdSearch {
     pub encodings: usize,
     /// Wall time of the search, seconds.
     pub seconds: f64,
+    /// (k, c) the search would have fitted but [`RdLimits::max_cost`] skipped: when the
+    /// chosen point sits at that edge, a larger limit may find a better one (at more time).
+    pub skipped_for_cost: usize,
 }
 
 impl RdSearch {
@@ -205,6 +208,7 @@ pub fn search_rate_distortion(
         encodings: 0,
         max_fits: limits.max_fits,
         max_cost: limits.max_cost,
+        too_costly: Vec::new(),
         done: HashMap::new(),
         best: None,
         best_model: None,
@@ -294,6 +298,7 @@ pub fn search_rate_distortion(
         fits: run.fits,
         encodings: run.encodings,
         seconds: start.elapsed().as_secs_f64(),
+        skipped_for_cost: run.too_costly.len(),
     })
 }
 
@@ -308,6 +313,8 @@ struct Run<'a> {
     encodings: usize,
     max_fits: usize,
     max_cost: f64,
+    /// (k, c) skipped by `max_cost`.
+    too_costly: Vec<(usize, usize)>,
     /// (k, c, c*) requested → the point judged (of the clamped k, c).
     done: HashMap<(usize, usize, Option<usize>), RdPoint>,
     best: Option<(RdPoint, Compressed)>,
@@ -328,9 +335,14 @@ impl Run<'_> {
     }
 
     /// Whether one local-PCA iteration of (k, c) stays within the cost limit.
-    fn affordable(&self, k: usize, c: usize) -> bool {
+    /// Skipped ones are counted (once each) for the caller's report.
+    fn affordable(&mut self, k: usize, c: usize) -> bool {
         let (v, f) = (self.frames.first().map_or(0, Vec::len), self.frames.len());
-        (v * k) as f64 * (c.min(3 * f) * 3 * f) as f64 <= self.max_cost
+        let ok = (v * k) as f64 * (c.min(3 * f) * 3 * f) as f64 <= self.max_cost;
+        if !ok && !self.too_costly.contains(&(k, c)) {
+            self.too_costly.push((k, c));
+        }
+        ok
     }
 
     fn best_kc(&self) -> Option<(usize, usize)> {

@@ -657,6 +657,9 @@ pub struct CompressArgs {
     /// clip).
     #[arg(long, default_value_t = RdLimits::default().max_fits)]
     max_fits: usize,
+    /// Largest V·k·c·3F (one local-PCA iteration) a full search fits.
+    #[arg(long, default_value_t = RdLimits::default().max_cost)]
+    max_cost: f64,
     /// Output: FILE.cpca.
     #[arg(long)]
     out: PathBuf,
@@ -669,6 +672,7 @@ impl CompressArgs {
             [
                 ("--target-da", self.target_da),
                 ("--target-bpvf", self.target_bpvf),
+                ("--max-cost", Some(self.max_cost)),
             ],
             [
                 ("--k-max", self.k_max),
@@ -707,6 +711,7 @@ impl CompressArgs {
                     k_max: self.k_max,
                     c_max: self.c_max,
                     max_fits: self.max_fits,
+                    max_cost: self.max_cost,
                     ..RdLimits::default()
                 }),
                 SearchArg::K => SearchMode::Clusters { k_max: self.k_max },

@@ -35,14 +35,23 @@ pub struct SearchReport {
     pub encodings: usize,
     /// Whether the chosen point meets the target (else it is the closest).
     pub reached: bool,
+    /// (k, c) skipped by the cost bound (`--max-cost`).
+    pub skipped_for_cost: usize,
 }
 
 impl SearchReport {
     /// The summary line's note on the search.
     pub fn text(&self) -> String {
         let what = if self.full {
+            let costly = match self.skipped_for_cost {
+                0 => String::new(),
+                n => format!(
+                    "; {n} larger (k, c) skipped as too slow to fit (--max-cost; raising it may \
+                     find a better point, at more time)"
+                ),
+            };
             format!(
-                "searched k, c, c*, q_c, q_w: {} points, {} fits, {} encodings",
+                "searched k, c, c*, q_c, q_w: {} points, {} fits, {} encodings{costly}",
                 self.points, self.fits, self.encodings
             )
         } else {
@@ -87,6 +96,7 @@ pub(super) fn search(
                 fits: found.steps.len(),
                 encodings: found.steps.len(),
                 reached: found.reached,
+                skipped_for_cost: 0,
             };
             Ok((found.compressed, report))
         }
@@ -107,6 +117,7 @@ pub(super) fn search(
                 fits: found.fits,
                 encodings: found.encodings,
                 reached: found.reached(),
+                skipped_for_cost: found.skipped_for_cost,
             };
             Ok((found.compressed, report))
         }
@@ -204,23 +215,23 @@ pub(super) enum SearchArg {
 }
 
 /// Refuses search flags no search can use, naming the flag, before the clip is loaded: a
-/// target that is not positive and finite, a limit of 0, and a parameter fixed on the command
+/// target (or the cost bound, `targets[2]`) that is not positive and finite, a limit of 0, and a parameter fixed on the command
 /// line (`fixed`: flag, given) that a full search would search instead.
 pub(super) fn check_flags(
-    targets: [(&str, Option<f64>); 2],
+    targets: [(&str, Option<f64>); 3],
     limits: [(&str, usize); 3],
     fixed: [(&str, bool); 4],
     search: SearchArg,
 ) -> anyhow::Result<()> {
     for (flag, value) in targets {
         if let Some(x) = value.filter(|x| !(x.is_finite() && *x > 0.0)) {
-            anyhow::bail!("{flag} {x}: a target must be a positive finite number");
+            anyhow::bail!("{flag} {x}: must be a positive finite number");
         }
     }
     if let Some((flag, _)) = limits.iter().find(|(_, n)| *n == 0) {
         anyhow::bail!("{flag} 0: a search limit must be at least 1");
     }
-    let targeted = targets.iter().any(|(_, t)| t.is_some());
+    let targeted = targets[..2].iter().any(|(_, t)| t.is_some());
     if let Some((flag, _)) = fixed.iter().find(|(_, given)| *given) {
         if targeted && search == SearchArg::Full {
             anyhow::bail!(
