@@ -174,17 +174,7 @@ pub fn search_rate_distortion(
     limits: &RdLimits,
     progress: &mut dyn FnMut(&RdPoint),
 ) -> Result<RdSearch> {
-    let value = match target {
-        RateTarget::Distortion(x) | RateTarget::Bpvf(x) => x,
-    };
-    if !(value.is_finite() && value > 0.0) {
-        return Err(invalid(
-            WHAT,
-            "target",
-            value,
-            "the target d_a or bpvf must be a positive finite number",
-        ));
-    }
+    target.check(WHAT)?;
     for (name, n) in [
         ("k_max", limits.k_max),
         ("c_max", limits.c_max),
@@ -550,23 +540,7 @@ impl Run<'_> {
             return Ok(top);
         }
         let allowance = target - top.1;
-        let mut count = 0;
-        let chosen = {
-            let mut encode = |qc: u8, qw: u8| {
-                count += 1;
-                encode_measured(
-                    model,
-                    self.frames,
-                    self.triangles,
-                    self.frame_rate,
-                    params,
-                    qc,
-                    qw,
-                )
-            };
-            fewest_bits_within(&mut encode, RD_MAX_BITS, top, allowance)?
-        };
-        self.encodings += count;
-        Ok(chosen)
+        let mut encode = |qc: u8, qw: u8| self.encode(model, params, qc, qw);
+        fewest_bits_within(&mut encode, RD_MAX_BITS, top, allowance)
     }
 }

@@ -30,6 +30,24 @@ pub enum RateTarget {
     Bpvf(f64),
 }
 
+impl RateTarget {
+    /// Refuses a target that is not a positive finite number, naming `what`.
+    pub(crate) fn check(self, what: &'static str) -> Result<()> {
+        let value = match self {
+            Self::Distortion(x) | Self::Bpvf(x) => x,
+        };
+        if !(value.is_finite() && value > 0.0) {
+            return Err(invalid(
+                what,
+                "target",
+                value,
+                "the target d_a or bpvf must be a positive finite number",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// One k tried.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SearchStep {
@@ -108,17 +126,7 @@ pub fn search_clusters(
     k_max: usize,
     progress: &mut dyn FnMut(&SearchStep),
 ) -> Result<ClusterSearch> {
-    let value = match target {
-        RateTarget::Distortion(x) | RateTarget::Bpvf(x) => x,
-    };
-    if !(value.is_finite() && value > 0.0) {
-        return Err(invalid(
-            WHAT,
-            "target",
-            value,
-            "the target d_a or bpvf must be a positive finite number",
-        ));
-    }
+    target.check(WHAT)?;
     if k_max == 0 {
         return Err(invalid(WHAT, "k_max", 0, "k_max must be at least 1"));
     }
