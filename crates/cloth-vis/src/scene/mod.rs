@@ -476,66 +476,6 @@ impl Scene {
         }
     }
 
-    /// Checks the `[btf]` table (only when the `btf` effect is requested).
-    fn validate_btf(&self) -> Result<(), Error> {
-        let b = &self.btf;
-        if let BtfSource::File(path) = self.btf_source()? {
-            if !path.exists() {
-                return Err(
-                    self.invalid("btf.source", format!("{} does not exist", path.display()))
-                );
-            }
-        }
-        if let Some(name) = b
-            .objects
-            .iter()
-            .find(|n| !self.objects.iter().any(|o| &o.name == *n))
-        {
-            return Err(self.invalid("btf.objects", format!("no object is named {name:?}")));
-        }
-        if !(1..=512).contains(&b.res) {
-            return Err(self.invalid("btf.res", format!("{} is outside 1..=512", b.res)));
-        }
-        if !(1..=btf::MAX_COMPONENTS).contains(&b.components) {
-            return Err(self.invalid(
-                "btf.components",
-                format!("{} is outside 1..={}", b.components, btf::MAX_COMPONENTS),
-            ));
-        }
-        let dir = Vec3::from(b.light_dir);
-        if !dir.is_finite() || dir.length_squared() == 0.0 {
-            return Err(self.invalid(
-                "btf.light_dir",
-                format!("{:?} must be a finite non-zero direction", b.light_dir),
-            ));
-        }
-        if b.radiance.iter().any(|c| !(c.is_finite() && *c >= 0.0)) {
-            return Err(self.invalid(
-                "btf.radiance",
-                format!("{:?} must be finite and ≥ 0", b.radiance),
-            ));
-        }
-        if !(b.uv_scale.is_finite() && b.uv_scale > 0.0) {
-            return Err(self.invalid(
-                "btf.uv_scale",
-                format!("{} must be finite and > 0", b.uv_scale),
-            ));
-        }
-        if Path::new(&b.png)
-            .file_name()
-            .is_none_or(|f| f != b.png.as_str())
-        {
-            return Err(self.invalid(
-                "btf.png",
-                format!(
-                    "{:?} must be a plain file name inside the output folder",
-                    b.png
-                ),
-            ));
-        }
-        Ok(())
-    }
-
     /// Resolve the environment's source, if there is an environment.
     ///
     /// # Errors

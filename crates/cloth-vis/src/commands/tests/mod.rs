@@ -5,6 +5,7 @@ mod common;
 
 mod anim_compress;
 mod anim_jumpmap;
+mod anim_search;
 mod inspect_cmd;
 mod render_outputs;
 mod visibility_cmd;
