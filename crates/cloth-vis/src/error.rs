@@ -51,6 +51,9 @@ pub enum Error {
     /// The visibility engine failed.
     #[error(transparent)]
     Visibility(#[from] occlusion_gpu::OcclusionError),
+    /// A visibility-map model, build or look-up failed (static self-shadowing).
+    #[error(transparent)]
+    Hemicube(#[from] hemicube::HemicubeError),
     /// A BTF folder or `.btfpca` file is invalid, or BTF compression failed (the message
     /// names the file and element).
     /// (Boxed: `BtfError` is large, and every `Result` of the facade would carry its size.)

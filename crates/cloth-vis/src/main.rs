@@ -34,6 +34,9 @@ enum Command {
     },
     /// Visibility matrix M and ambient term a_i of a mesh or an animation (paper 000).
     Visibility(commands::visibility::VisibilityArgs),
+    /// Static self-shadowing from per-vertex visibility maps: hemicube, single plane or
+    /// hemisphere, under an environment and point lights (thesis §4.3).
+    Hemicube(commands::hemicube::HemicubeArgs),
     /// Load a mesh or an animation and print what the loader found (counts, quirks, time).
     Inspect(commands::inspect::InspectArgs),
 }
@@ -51,6 +54,7 @@ fn main() -> ExitCode {
         Command::Anim { command } => command.run(),
         Command::Btf { command } => command.run(),
         Command::Visibility(args) => args.run(),
+        Command::Hemicube(args) => args.run(),
         Command::Inspect(args) => args.run(),
     };
     match result {

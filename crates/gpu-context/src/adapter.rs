@@ -166,9 +166,12 @@ impl GpuContext {
         };
         // Optional features the renderer uses when the adapter has them: MSAA on Rgba32Float
         // (adapter-specific format features), a float depth with stencil, float32 blending.
+        // Clip distances let the hemicube builder clip every tile of its atlas in one
+        // instanced draw.
         let optional = (wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES
             | wgpu::Features::DEPTH32FLOAT_STENCIL8
-            | wgpu::Features::FLOAT32_BLENDABLE)
+            | wgpu::Features::FLOAT32_BLENDABLE
+            | wgpu::Features::CLIP_DISTANCES)
             & adapter.features();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("cloth-vis device"),

@@ -142,14 +142,14 @@ impl EdgeTriangle {
 }
 
 /// The scene's BVH with triangles stored in BVH leaf order.
-struct CpuTracer {
+pub(crate) struct CpuTracer {
     bvh: CwBvh,
     triangles: Vec<EdgeTriangle>,
 }
 
 impl CpuTracer {
     /// Builds the BVH over all scene triangles (degenerate ones included: they never hit).
-    fn new(prepared: &Prepared) -> Self {
+    pub(crate) fn new(prepared: &Prepared) -> Self {
         let tris = scene_triangles(prepared);
         if tris.is_empty() {
             return Self {
@@ -177,24 +177,31 @@ impl CpuTracer {
         Self { bvh, triangles }
     }
 
-    /// Whether a ray from `origin` towards `direction` escapes to infinity. `cache` is the
-    /// last blocking triangle seen for this direction (or [`NO_TRIANGLE`]): it is tested
-    /// first, and updated to the triangle that blocks this ray.
+    /// Whether a ray from `origin` towards `direction` meets no triangle before `max_t`
+    /// (`f32::INFINITY`: escapes to infinity). `cache` is the last blocking triangle seen for
+    /// this direction (or [`NO_TRIANGLE`]): it is tested first, and updated to the triangle
+    /// that blocks this ray.
     #[inline]
-    fn unoccluded_cached(&self, origin: Vec3A, direction: Vec3A, cache: &mut u32) -> bool {
+    pub(crate) fn unoccluded_cached(
+        &self,
+        origin: Vec3A,
+        direction: Vec3A,
+        max_t: f32,
+        cache: &mut u32,
+    ) -> bool {
         if let Some(t) = self.triangles.get(*cache as usize)
-            && t.intersect(origin, direction) < f32::INFINITY
+            && t.intersect(origin, direction) < max_t
         {
             return false;
         }
         if self.triangles.is_empty() {
             return true;
         }
-        let ray = Ray::new(origin, direction, 0.0, f32::INFINITY);
+        let ray = Ray::new(origin, direction, 0.0, max_t);
         let mut blocker = NO_TRIANGLE;
         let miss = self.bvh.ray_traverse_miss(ray, |r, id| {
             let t = self.triangles[id].intersect(r.origin, r.direction);
-            if t < f32::INFINITY {
+            if t < r.tmax {
                 blocker = id as u32;
             }
             t
@@ -496,7 +503,7 @@ fn bvh_columns(
                         continue;
                     }
                     rays += 1;
-                    if tracer.unoccluded_cached(origin, direction, &mut cache[j]) {
+                    if tracer.unoccluded_cached(origin, direction, f32::INFINITY, &mut cache[j]) {
                         out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
                     }
                 }

@@ -81,6 +81,7 @@ mod filter;
 mod gpu;
 mod level;
 mod matrix;
+mod rays;
 mod rigid;
 mod scene;
 
@@ -102,5 +103,6 @@ pub use level::{
     DEFAULT_RISE_FRACTION, LevelChange, LevelController, LevelParams,
 };
 pub use matrix::{VisibilityMatrix, clamp_ambient};
+pub use rays::{RayCache, RayCaster};
 pub use rigid::RigidLighting;
 pub use scene::{MAX_ELEMENTS, Scene, SceneObject};

@@ -222,7 +222,6 @@ pub(crate) struct Receiver {
 #[derive(Clone, Debug)]
 pub(crate) struct Prepared {
     /// World-space centre of the bounding box (subtracted from every position).
-    #[allow(dead_code)]
     pub center: DVec3,
     /// Bounding-box diagonal length.
     pub diagonal: f32,

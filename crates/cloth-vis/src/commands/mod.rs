@@ -8,6 +8,7 @@ pub mod cpca;
 mod cpca_bits;
 mod cpca_figures;
 mod cpca_search;
+pub mod hemicube;
 pub mod inspect;
 pub mod jumpmap;
 pub mod parse;

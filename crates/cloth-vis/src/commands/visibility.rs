@@ -61,7 +61,7 @@ const AUTO_EXPOSURE_KEY: f32 = render::tone::AUTO_EXPOSURE_KEY;
 /// Default display gamma of `--render` PNGs and of `.ply` colours.
 pub const DEFAULT_GAMMA: f32 = 2.2;
 /// Default `--render-size` (width x height).
-const DEFAULT_RENDER_SIZE: &str = "768x768";
+pub(super) const DEFAULT_RENDER_SIZE: &str = "768x768";
 /// `_AO` value of a vertex used by no face in a `.glb` (glTF forbids NaN).
 pub const GLB_UNUSED_AO: f32 = -1.0;
 
@@ -173,7 +173,7 @@ enum ImageKind {
     Exr,
 }
 
-fn lower_extension(path: &Path) -> Option<String> {
+pub(super) fn lower_extension(path: &Path) -> Option<String> {
     path.extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
@@ -268,9 +268,9 @@ fn check_request(
 }
 
 /// Largest `--render-size` side (wgpu's guaranteed 2D texture limit).
-const MAX_RENDER_SIDE: u32 = 8192;
+pub(super) const MAX_RENDER_SIDE: u32 = 8192;
 /// Largest `--exposure` magnitude in stops (2^±64 covers every f32 radiance range).
-const MAX_EXPOSURE_EV: f32 = 64.0;
+pub(super) const MAX_EXPOSURE_EV: f32 = 64.0;
 
 /// The one-object scene the request describes: the input as a white one-sided object, the
 /// lightsphere level, the visibility backend and depth resolution, an automatically framed
@@ -412,7 +412,15 @@ pub fn run_visibility(
         }
         (Some(OutKind::Ply), Some(path), Some(c)) => {
             let colours = display_colours(c);
-            write_ply(path, positions, normals, triangles, &colours, last_ambient)?;
+            write_ply(
+                path,
+                "cloth-vis visibility: ao = a_i (NaN: vertex used by no face)",
+                positions,
+                normals,
+                triangles,
+                &colours,
+                last_ambient,
+            )?;
         }
         (Some(OutKind::Glb), Some(path), Some(c)) => {
             write_glb(path, positions, normals, triangles, c, last_ambient)?;
@@ -446,7 +454,7 @@ pub fn run_visibility(
 
 /// Linear display colours: radiance scaled so that the 90th percentile of luminance is 0.8,
 /// clamped to [0, 1]; black for non-finite radiance (unused vertices).
-fn linear_display_colours(c: &[Vec3]) -> Vec<Vec3> {
+pub(super) fn linear_display_colours(c: &[Vec3]) -> Vec<Vec3> {
     let lum = c.iter().map(|v| render::tone::luminance(v.to_array()));
     let scale = render::tone::auto_exposure_ev(
         lum,
@@ -466,7 +474,7 @@ fn linear_display_colours(c: &[Vec3]) -> Vec<Vec3> {
 }
 
 /// Map radiance to display colours: the 90th percentile of luminance to 0.8, gamma 2.2.
-fn display_colours(c: &[Vec3]) -> Vec<Vec3> {
+pub(super) fn display_colours(c: &[Vec3]) -> Vec<Vec3> {
     linear_display_colours(c)
         .into_iter()
         .map(|v| v.powf(1.0 / DEFAULT_GAMMA))
@@ -475,7 +483,7 @@ fn display_colours(c: &[Vec3]) -> Vec<Vec3> {
 
 /// glTF binary with positions, normals (+Y for unused vertices), linear `COLOR_0` and `_AO`
 /// (−1 for unused vertices), written atomically.
-fn write_glb(
+pub(super) fn write_glb(
     path: &Path,
     positions: &[Vec3],
     normals: &[Vec3],
@@ -502,8 +510,9 @@ fn write_glb(
 
 /// Binary little-endian PLY with positions, normals, 8-bit colour and a float `ao`, written
 /// atomically.
-fn write_ply(
+pub(super) fn write_ply(
     path: &Path,
+    comment: &str,
     positions: &[Vec3],
     normals: &[Vec3],
     triangles: &[[u32; 3]],
@@ -513,13 +522,13 @@ fn write_ply(
     atomic_out::write_with(path, |w| {
         write!(
             w,
-            "ply\nformat binary_little_endian 1.0\ncomment cloth-vis visibility: ao = a_i (NaN: vertex used by no face)\n\
+            "ply\nformat binary_little_endian 1.0\ncomment {comment}\n\
              element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
              property float nx\nproperty float ny\nproperty float nz\n\
              property uchar red\nproperty uchar green\nproperty uchar blue\nproperty float ao\n\
              element face {}\nproperty list uchar uint vertex_indices\nend_header\n",
             positions.len(),
-            triangles.len()
+            triangles.len(),
         )?;
         for i in 0..positions.len() {
             for v in positions[i]
