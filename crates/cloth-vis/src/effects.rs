@@ -15,6 +15,8 @@ pub enum Effect {
     Lighting,
     /// Per-vertex self-shadowing from the visibility matrix M (paper 000; occlusion-gpu).
     SelfShadowing,
+    /// Static self-shadowing from per-vertex visibility maps (thesis §4.3; hemicube).
+    StaticShadowing,
     /// Measured-material (BTF) rendering (thesis §5.3–5.6).
     Btf,
     /// Shadow volumes with smooth boundaries (thesis §4.2, §5.5.1).
@@ -25,9 +27,10 @@ pub enum Effect {
 
 impl Effect {
     /// Every effect, in the order stages run.
-    pub const ALL: [Effect; 5] = [
+    pub const ALL: [Effect; 6] = [
         Effect::Lighting,
         Effect::SelfShadowing,
+        Effect::StaticShadowing,
         Effect::Btf,
         Effect::ShadowVolumes,
         Effect::Translucency,
@@ -38,6 +41,7 @@ impl Effect {
         match self {
             Effect::Lighting => "lighting",
             Effect::SelfShadowing => "self-shadowing",
+            Effect::StaticShadowing => "static-shadowing",
             Effect::Btf => "btf",
             Effect::ShadowVolumes => "shadow-volumes",
             Effect::Translucency => "translucency",
@@ -47,7 +51,10 @@ impl Effect {
     /// Whether this build contains the effect's stage. Effects that are not built yet are
     /// rejected when a scene is validated, before any work starts.
     pub fn is_built(self) -> bool {
-        matches!(self, Effect::Lighting | Effect::SelfShadowing | Effect::Btf)
+        matches!(
+            self,
+            Effect::Lighting | Effect::SelfShadowing | Effect::StaticShadowing | Effect::Btf
+        )
     }
 
     /// The crate that will provide an effect that is not built yet.
@@ -55,6 +62,7 @@ impl Effect {
         match self {
             Effect::Lighting => "cloth-vis + lightsphere",
             Effect::SelfShadowing => "occlusion-gpu",
+            Effect::StaticShadowing => "hemicube",
             Effect::Btf => "btf",
             Effect::ShadowVolumes => "shadows",
             Effect::Translucency => "translucency",

@@ -52,6 +52,7 @@ pub mod report;
 pub mod run;
 pub mod scene;
 pub mod shadowing;
+pub mod static_shadowing;
 
 pub use demo::{DEMO_SCENE, demo_scene, run_demo};
 pub use effects::Effect;

@@ -6,6 +6,7 @@
 //! | `environment` | `lighting` is requested, or an environment is drawn as the backdrop |
 //! | `light-directions` | `lighting` or `self-shadowing` (lightsphere level, I_j per direction) |
 //! | `visibility` | `self-shadowing` (the visibility matrix M, occlusion-gpu) |
+//! | `static-visibility` | `static-shadowing` (per-vertex visibility maps and their radiance, hemicube) |
 //! | `lighting` | `lighting` or `self-shadowing` (per-vertex radiance, with M when computed) |
 //! | `render` | always (PNG/EXR) |
 //! | `btf` | `btf` (a compressed BTF on the objects with UVs, beside plain texturing; its own PNG) |
@@ -30,6 +31,8 @@ pub enum Stage {
     LightDirections,
     /// The visibility matrix M of every vertex towards every light direction.
     Visibility,
+    /// Per-vertex visibility maps (thesis §4.3) and the radiance they let through.
+    StaticVisibility,
     /// Per-vertex image-based radiance.
     Lighting,
     /// Rasterise and write images.
@@ -46,6 +49,7 @@ impl Stage {
             Stage::Environment => "environment",
             Stage::LightDirections => "light-directions",
             Stage::Visibility => "visibility",
+            Stage::StaticVisibility => "static-visibility",
             Stage::Lighting => "lighting",
             Stage::Render => "render",
             Stage::Btf => "btf",
@@ -62,6 +66,7 @@ impl Stage {
                 Stage::Visibility,
                 Stage::Lighting,
             ],
+            Effect::StaticShadowing => &[Stage::Environment, Stage::StaticVisibility],
             Effect::Btf => &[Stage::Btf],
             // Not built yet: validation rejects them before planning.
             Effect::ShadowVolumes | Effect::Translucency => &[],

@@ -20,6 +20,7 @@ use crate::plan::{Plan, Stage};
 use crate::report::{RunReport, StageRecord};
 use crate::scene::{BackgroundDesc, BackgroundKeyword, ExposureDesc, GROUND_NAME, Scene, ToneDesc};
 use crate::shadowing::VisibilityStage;
+use crate::static_shadowing::StaticShadowingStage;
 
 /// How a scene is run.
 #[derive(Clone, Debug, Default)]
@@ -168,6 +169,15 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
     } else {
         None
     };
+    let statics = if plan.contains(Stage::StaticVisibility) {
+        let env = environment.as_ref().ok_or_else(|| Error::Scene {
+            origin: scene.origin.clone(),
+            message: "static-shadowing planned without an environment".to_owned(),
+        })?;
+        Some((StaticShadowingStage::new(scene, Some(&gpu))?, env))
+    } else {
+        None
+    };
     let look = Look {
         camera,
         background,
@@ -183,6 +193,11 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                 if let Some(lights) = &lights {
                     light_frame(shadowing.as_mut(), &mut objects, lights, &mut timer)?;
                 }
+                if let Some((stage, env)) = &statics {
+                    timer.run(Stage::StaticVisibility, || {
+                        Ok(((), stage.light(Some(&gpu), &mut objects, env)?))
+                    })?;
+                }
                 timer.run(Stage::Render, || {
                     let (image, params, written) =
                         render_still(scene, tmp, &gpu, &mut renderer, &objects, &look)?;
@@ -196,6 +211,7 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                     tmp,
                     &gpu,
                     shadowing.as_mut(),
+                    statics.as_ref().map(|(stage, env)| (stage, *env)),
                     &mut renderer,
                     &mut objects,
                     lights.as_ref(),
@@ -593,6 +609,7 @@ fn render_sequence(
     out_dir: &Path,
     gpu: &GpuContext,
     mut shadowing: Option<&mut VisibilityStage>,
+    statics: Option<(&StaticShadowingStage, &lightsphere::Environment)>,
     renderer: &mut Renderer,
     objects: &mut [WorldObject],
     lights: Option<&Lights>,
@@ -603,7 +620,8 @@ fn render_sequence(
 ) -> Result<(HdrImage, Vec<PathBuf>), Error> {
     let bar = progress_bar(progress, range.len() as u64, "rendering frames");
     let (mut pose_t, mut vis_t, mut light_t, mut render_t, mut write_t) = Default::default();
-    let (mut vis_params, mut light_params) = (json!({}), json!({}));
+    let mut static_t = FrameTimes::default();
+    let (mut vis_params, mut light_params, mut static_params) = (json!({}), json!({}), json!({}));
     let mut display: Option<Display> = None;
     let mut written = Vec::new();
     let mut last = None;
@@ -629,6 +647,11 @@ fn render_sequence(
             FrameTimes::add(&mut light_t, ms_since(t));
             light_params = json!({ "vertices": vertices, "directions": sphere.len() });
         }
+        if let Some((stage, env)) = statics {
+            let t = Instant::now();
+            static_params = stage.light(Some(gpu), objects, env)?;
+            FrameTimes::add(&mut static_t, ms_since(t));
+        }
         let t = Instant::now();
         set_gouraud_meshes(gpu, renderer, objects, &look.camera, &[])?;
         let image = renderer.render(&gpu.device, &gpu.queue, &look.camera, look.background, &[])?;
@@ -647,13 +670,14 @@ fn render_sequence(
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let times: [(Stage, &FrameTimes, serde_json::Value); 4] = [
+    let times: [(Stage, &FrameTimes, serde_json::Value); 5] = [
         (
             Stage::Geometry,
             &pose_t,
             json!({ "what": "pose and normals per frame" }),
         ),
         (Stage::Visibility, &vis_t, vis_params),
+        (Stage::StaticVisibility, &static_t, static_params),
         (Stage::Lighting, &light_t, light_params),
         (
             Stage::Render,

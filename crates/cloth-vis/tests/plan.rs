@@ -220,3 +220,62 @@ fn typos_and_bad_values_are_reported_with_location() {
         .to_string();
     assert!(err.contains("albedo") && err.contains("1.5"), "{err}");
 }
+
+#[test]
+fn static_shadowing_plans_its_maps_and_no_light_directions() {
+    let text = format!(
+        "effects = [\"static-shadowing\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
+    );
+    let plan = Plan::for_scene(&scene(&text, ".".as_ref())).unwrap();
+    assert_eq!(
+        plan.stages(),
+        &[
+            Stage::Geometry,
+            Stage::Environment,
+            Stage::StaticVisibility,
+            Stage::Render
+        ]
+    );
+}
+
+#[test]
+fn bad_static_shadowing_tables_are_named_before_any_work() {
+    let base = format!("{CLOTH}\n[environment]\nsource = \"synth:sky\"\n");
+    for (effects, table, key) in [
+        (
+            "\"static-shadowing\"",
+            "model = \"cube\"",
+            "static_shadowing.model",
+        ),
+        ("\"static-shadowing\"", "res = 7", "static_shadowing.res"),
+        ("\"static-shadowing\"", "res = 0", "static_shadowing.res"),
+        (
+            "\"static-shadowing\"",
+            "model = \"sp\"\naperture_deg = 180.0",
+            "static_shadowing.aperture_deg",
+        ),
+        (
+            "\"static-shadowing\"",
+            "lookup = \"nearest\"",
+            "static_shadowing.lookup",
+        ),
+        (
+            "\"static-shadowing\"",
+            "model = \"hs\"\nbuilder = \"gpu\"",
+            "static_shadowing.builder",
+        ),
+        ("\"static-shadowing\", \"self-shadowing\"", "", "choose one"),
+    ] {
+        let text = format!("effects = [{effects}]\n{base}\n[static_shadowing]\n{table}\n");
+        let err = Plan::for_scene(&scene(&text, ".".as_ref()))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(key), "{table}: {err}");
+    }
+    // Without an environment there is nothing to shadow.
+    let text = format!("effects = [\"static-shadowing\"]\n{CLOTH}\n");
+    let err = Plan::for_scene(&scene(&text, ".".as_ref()))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("environment"), "{err}");
+}

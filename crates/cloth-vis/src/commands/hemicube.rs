@@ -491,7 +491,7 @@ pub struct HemicubeArgs {
     builder: Option<String>,
     /// The seed's triangle preselection: ignore occluders farther than D units of the mesh's
     /// largest side (cpu builder).
-    #[arg(long, value_name = "D")]
+    #[arg(long, value_name = "D", allow_negative_numbers = true)]
     max_distance: Option<f32>,
     /// HDR environment (.hdr/.exr).
     #[arg(long, conflicts_with = "sky")]

@@ -37,11 +37,13 @@ use crate::{Effect, Error};
 
 mod btf_table;
 mod output;
+mod static_table;
 
 pub use btf_table::BtfDesc;
 pub use output::{
     AutoKeyword, BackgroundDesc, BackgroundKeyword, ExposureDesc, GroundDesc, OutputDesc, ToneDesc,
 };
+pub use static_table::{StaticBuilderDesc, StaticShadowingDesc};
 
 /// Prefix of procedural sources in scene files.
 pub const SYNTH_PREFIX: &str = "synth:";
@@ -78,6 +80,9 @@ pub struct Scene {
     /// Visibility parameters (the `self-shadowing` effect).
     #[serde(default)]
     pub visibility: VisibilityDesc,
+    /// Visibility maps (the `static-shadowing` effect).
+    #[serde(default)]
+    pub static_shadowing: StaticShadowingDesc,
     /// Procedural data parameters (for `synth:` sources).
     #[serde(default)]
     pub synth: SynthDesc,
@@ -578,9 +583,23 @@ impl Scene {
         if effects.contains(&Effect::Btf) {
             self.validate_btf()?;
         }
-        let lit = effects
-            .iter()
-            .find(|e| matches!(e, Effect::Lighting | Effect::SelfShadowing));
+        if effects.contains(&Effect::StaticShadowing) {
+            if effects.contains(&Effect::SelfShadowing) {
+                return Err(self.invalid(
+                    "effects",
+                    "\"self-shadowing\" and \"static-shadowing\" both light the vertices: choose one \
+                     (self-shadowing recomputes per frame, static-shadowing reads per-vertex maps)"
+                        .to_owned(),
+                ));
+            }
+            self.validate_static_shadowing()?;
+        }
+        let lit = effects.iter().find(|e| {
+            matches!(
+                e,
+                Effect::Lighting | Effect::SelfShadowing | Effect::StaticShadowing
+            )
+        });
         if let (Some(effect), None) = (lit, &self.environment) {
             return Err(self.invalid(
                 "environment",

@@ -1,0 +1,120 @@
+//! The static-shadowing effect's wiring against the hemicube crate: under a constant
+//! environment L every vertex gets ρ L Σ_p V_p ΔF_p, front and (two-sided) back; an occluder
+//! above a sheet darkens its top, not its underside.
+
+mod common;
+
+use std::sync::Arc;
+
+use cloth_vis::object::WorldObject;
+use cloth_vis::static_shadowing::StaticShadowingStage;
+use glam::Vec3;
+
+fn sheet(n: usize, size: f32, y: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let s = size / (n - 1) as f32;
+    let positions = (0..n * n)
+        .map(|k| {
+            Vec3::new(
+                (k / n) as f32 * s - size / 2.0,
+                y,
+                (k % n) as f32 * s - size / 2.0,
+            )
+        })
+        .collect();
+    let mut triangles = Vec::new();
+    for i in 0..n - 1 {
+        for j in 0..n - 1 {
+            let a = (i * n + j) as u32;
+            let (b, c, d) = (a + 1, a + n as u32, a + n as u32 + 1);
+            triangles.push([a, b, d]);
+            triangles.push([a, d, c]);
+        }
+    }
+    (positions, triangles)
+}
+
+fn object(name: &str, (positions, triangles): (Vec<Vec3>, Vec<[u32; 3]>)) -> WorldObject {
+    let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
+    WorldObject {
+        name: name.to_owned(),
+        positions,
+        normals,
+        triangles,
+        uvs: None,
+        albedo: Vec3::new(0.5, 0.25, 1.0),
+        two_sided: true,
+        front: None,
+        back: None,
+        animation: None,
+    }
+}
+
+#[test]
+fn constant_sky_gives_albedo_times_radiance_times_open_fraction_on_both_sides() {
+    let text = "effects = [\"static-shadowing\"]\n[[object]]\nname = \"a\"\nsource = \"synth:cloth\"\n\
+                [environment]\nsource = \"synth:sky\"\n[static_shadowing]\nres = 16\nbuilder = \"cpu\"\nlookup = \"exact\"\n";
+    let scene = common::scene(text, ".".as_ref());
+    let stage = StaticShadowingStage::new(&scene, None).unwrap();
+    let l = 2.0f32;
+    let env = lightsphere::Environment::from_latlong(64, 32, vec![[l; 3]; 64 * 32]).unwrap();
+    // The lower sheet is two-sided and normals face +y (the winding above); the upper sheet
+    // covers its centre.
+    let mut objects = vec![
+        object("low", sheet(9, 2.0, 0.0)),
+        object("high", sheet(3, 0.5, 0.3)),
+    ];
+    stage.light(None, &mut objects, &env).unwrap();
+    // The reference: the hemicube maps of the same scene, front then back rows.
+    let mut occ = occlusion_gpu::Scene::new();
+    for o in &objects {
+        occ.push(occlusion_gpu::SceneObject::new(
+            o.positions.clone(),
+            o.normals.clone(),
+            o.triangles.clone(),
+        ))
+        .unwrap();
+        let flipped = o.normals.iter().map(|n| -*n).collect();
+        occ.push(occlusion_gpu::SceneObject::new(
+            o.positions.clone(),
+            flipped,
+            o.triangles.clone(),
+        ))
+        .unwrap();
+    }
+    let layout = Arc::new(
+        hemicube::PixelLayout::new(
+            hemicube::Model::Hemicube { res: 16 },
+            hemicube::FormFactorRule::Exact,
+        )
+        .unwrap(),
+    );
+    let (maps, _) =
+        hemicube::build_with_rays(&occ, layout, &hemicube::BuildParams::default()).unwrap();
+    let open = maps.open_fraction();
+    let low = &objects[0];
+    let (front, back) = (low.front.as_ref().unwrap(), low.back.as_ref().unwrap());
+    let n = low.positions.len();
+    for i in 0..n {
+        let f = low.albedo * l * open[i];
+        let b = low.albedo * l * open[n + i];
+        assert!(
+            (front[i] - f).abs().max_element() < 1e-5,
+            "front {i}: {} vs {f}",
+            front[i]
+        );
+        assert!(
+            (back[i] - b).abs().max_element() < 1e-5,
+            "back {i}: {} vs {b}",
+            back[i]
+        );
+    }
+    // The centre of the lower sheet: shadowed on top by the upper sheet, open underneath.
+    let centre = 4 * 9 + 4;
+    let normal_up = low.normals[centre].y > 0.0;
+    let (top, under) = if normal_up {
+        (front[centre], back[centre])
+    } else {
+        (back[centre], front[centre])
+    };
+    assert!(top.x < 0.9 * under.x, "top {top} under {under}");
+}
