@@ -11,16 +11,21 @@ use occlusion_gpu::{Scene, SceneObject};
 
 const DRESS: &str = "meshes/garments/dress-victor-iso-draped.obj";
 
-fn dress() -> Option<(Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>)> {
+fn dress() -> Option<meshio::Mesh> {
     let path = test_data::shared_file(DRESS)?;
     let (mesh, _) = meshio::load_mesh(&path, &meshio::LoadOptions::default()).unwrap();
-    Some((mesh.positions, mesh.normals, mesh.triangles))
+    Some(mesh)
 }
 
 /// The dress as occluder, and every `step`-th used vertex as a receiver point (no triangles of
 /// its own, so it occludes nothing twice).
 fn sampled(step: usize) -> Option<Scene> {
-    let (positions, normals, triangles) = dress()?;
+    let meshio::Mesh {
+        positions,
+        normals,
+        triangles,
+        ..
+    } = dress()?;
     let mut scene = Scene::new();
     scene
         .push(SceneObject::new(positions.clone(), normals.clone(), triangles).occluder_only())

@@ -1,0 +1,130 @@
+//! Table 4.1 of the thesis (§4.3.5) on the shared draped dress (4,589 vertices): every
+//! model × resolution of the table by the exact ray builder, HC 64² (the issue's ≤ 10 s
+//! target), and the GPU atlas for HC and SP on the available adapter — the whole dress on a
+//! hardware GPU; on a software one (lavapipe rasterises on these CPUs and is slow at it) every
+//! 15th vertex, named `sampled`. Throughput = rays or pixels per second. The BVH is built once
+//! outside the timing (static maps are built once per mesh).
+//!
+//! The thesis's seconds (Celeron 800 MHz + TNT2), fastest method per configuration: HC 8² 15.2,
+//! HC 16² 17.0, SP 8² 3.1, SP 16² 3.7, HS 16×4 7.2, HS 32×8 20.6. Skips with a message when
+//! `../shared/data` is missing. Run with `cargo bench -p hemicube --bench build`.
+
+use std::sync::Arc;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec3;
+use hemicube::{
+    BuildParams, FormFactorRule, GpuBuilder, Model, PixelLayout, RingSpacing, build_with_caster,
+};
+use occlusion_gpu::{RayCaster, Scene, SceneObject};
+
+const DRESS: &str = "meshes/garments/dress-victor-iso-draped.obj";
+
+fn dress(step: usize) -> Option<Scene> {
+    let path = test_data::data_root().join(DRESS);
+    if !path.is_file() {
+        println!("skipping: {} not found", path.display());
+        return None;
+    }
+    let (mesh, _) = meshio::load_mesh(&path, &meshio::LoadOptions::default()).ok()?;
+    if step == 1 {
+        return Scene::single(mesh.positions, mesh.normals, mesh.triangles).ok();
+    }
+    let picked: Vec<usize> = (0..mesh.positions.len())
+        .filter(|&i| mesh.normals[i] != Vec3::ZERO)
+        .step_by(step)
+        .collect();
+    let mut scene = Scene::new();
+    let receiver = SceneObject::new(
+        picked.iter().map(|&i| mesh.positions[i]).collect(),
+        picked.iter().map(|&i| mesh.normals[i]).collect(),
+        Vec::new(),
+    );
+    scene
+        .push(SceneObject::new(mesh.positions, mesh.normals, mesh.triangles).occluder_only())
+        .ok()?;
+    scene.push(receiver).ok()?;
+    Some(scene)
+}
+
+fn hs(phi: u32, theta: u32) -> Model {
+    Model::Hemisphere {
+        phi,
+        theta,
+        spacing: RingSpacing::EqualTheta,
+    }
+}
+
+fn sp(res: u32) -> Model {
+    Model::SinglePlane {
+        res,
+        aperture_deg: hemicube::DEFAULT_APERTURE_DEG,
+    }
+}
+
+fn rays(c: &mut Criterion) {
+    let Some(scene) = dress(1) else { return };
+    let caster = RayCaster::new(&scene).expect("valid scene");
+    let mut group = c.benchmark_group("hemicube/rays/dress");
+    group.sample_size(10);
+    for model in [
+        Model::Hemicube { res: 8 },
+        Model::Hemicube { res: 16 },
+        sp(8),
+        sp(16),
+        hs(16, 4),
+        hs(32, 8),
+        Model::Hemicube { res: 64 },
+    ] {
+        let layout = Arc::new(PixelLayout::new(model, FormFactorRule::Exact).unwrap());
+        let rays = (caster.receiver_count() * layout.len()) as u64;
+        group.throughput(Throughput::Elements(rays));
+        group.bench_function(model.label(), |b| {
+            b.iter(|| build_with_caster(&caster, layout.clone(), &BuildParams::default()));
+        });
+    }
+}
+
+fn gpu(c: &mut Criterion) {
+    let Ok(gpu) = gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()) else {
+        println!("skipping the GPU atlas: no adapter");
+        return;
+    };
+    let software = gpu.summary().is_software;
+    let step = if software { 15 } else { 1 };
+    let Some(scene) = dress(step) else { return };
+    let caster = RayCaster::new(&scene).expect("valid scene");
+    let name = if software {
+        "hemicube/gpu/dress-sampled"
+    } else {
+        "hemicube/gpu/dress"
+    };
+    let mut group = c.benchmark_group(name);
+    group.sample_size(10);
+    for model in [
+        Model::Hemicube { res: 8 },
+        Model::Hemicube { res: 16 },
+        sp(8),
+        sp(16),
+        Model::Hemicube { res: 64 },
+    ] {
+        let layout = Arc::new(PixelLayout::new(model, FormFactorRule::Exact).unwrap());
+        let Ok(builder) = GpuBuilder::new(&gpu, layout.clone()) else {
+            println!("skipping the GPU atlas: the adapter lacks clip distances");
+            return;
+        };
+        group.throughput(Throughput::Elements(
+            (caster.receiver_count() * layout.len()) as u64,
+        ));
+        group.bench_function(model.label(), |b| {
+            b.iter(|| {
+                builder
+                    .build_with_caster(&gpu, &caster, &BuildParams::default())
+                    .expect("GPU build")
+            });
+        });
+    }
+}
+
+criterion_group!(benches, rays, gpu);
+criterion_main!(benches);
