@@ -20,12 +20,17 @@
 //!   (thesis §5.4) — error, time and `.btfpca` size against c, eigenvalue decay and a Fig. 5.7
 //!   panel; FMF, PCMF and PVMF side by side (Fig. 2.22); compression time and peak memory at
 //!   256² (`target/repro/btf.md`, `btf-error.svg`, `btf-eigenvalues.svg`, `btf-fig5.7.png`).
+//! - `cargo xtask repro hemicube [--quick]`: static visibility maps (thesis §4.3) on the shared
+//!   dress — Table 4.1 rebuilt (GPU atlas and exact rays beside the thesis's four builders),
+//!   HC 64² of the whole dress, convergence of HC/SP/HS against an HC 256² reference, the
+//!   lightsphere's a_i beside it, bytes per vertex (`target/repro/hemicube.md`, `hemicube.svg`).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 
 mod compare_clustering;
 mod repro_anim_compression;
 mod repro_btf;
+mod repro_hemicube;
 mod repro_jumpmap;
 mod repro_lightsphere;
 mod repro_rd_search;
@@ -108,6 +113,14 @@ enum Repro {
         #[arg(long)]
         quick: bool,
     },
+    /// Static visibility maps (thesis §4.3): Table 4.1 rebuilt on the shared dress, convergence
+    /// of HC/SP/HS against an HC 256² reference, the lightsphere's a_i beside it, bytes per
+    /// vertex.
+    Hemicube {
+        /// HC 128² reference instead of 256².
+        #[arg(long)]
+        quick: bool,
+    },
 }
 
 /// `target/repro` of the workspace.
@@ -136,6 +149,9 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Btf { quick },
         } => repro_btf::run(&repro_dir()?, quick),
+        Command::Repro {
+            what: Repro::Hemicube { quick },
+        } => repro_hemicube::run(&repro_dir()?, quick),
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {

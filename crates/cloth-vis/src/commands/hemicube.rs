@@ -35,6 +35,9 @@ use hemicube::{
 };
 use occlusion_gpu::RayCaster;
 
+/// Largest total size of the maps (1 bit per pixel) the command builds.
+const MAX_MAP_BYTES: u64 = 2 << 30;
+
 /// Which builder makes the maps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Builder {
@@ -333,6 +336,21 @@ pub fn run_hemicube(
     }
     objects[0].pose(request.frame);
     let object = &objects[0];
+    let map_bytes =
+        object.positions.len() as u64 * request.model.pixel_count().div_ceil(64) as u64 * 8;
+    if map_bytes > MAX_MAP_BYTES {
+        return Err(invalid(
+            input,
+            format!(
+                "{} maps of {} vertices would take {:.1} GiB, more than the {} GiB this command \
+                 holds: lower --res",
+                request.model.label(),
+                object.positions.len(),
+                map_bytes as f64 / (1u64 << 30) as f64,
+                MAX_MAP_BYTES >> 30
+            ),
+        ));
+    }
     let occ = occlusion_gpu::Scene::single(
         object.positions.clone(),
         object.normals.clone(),

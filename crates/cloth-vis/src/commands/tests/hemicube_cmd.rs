@@ -170,6 +170,21 @@ fn bad_flags_are_refused_naming_the_value() {
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!out.exists(), "{args:?} left an output");
     }
+    // 2.3 GB of maps (4,356 vertices × 2048² bits): refused after loading, before building.
+    let run = cli(&[
+        "hemicube",
+        "synth:cloth",
+        "--model",
+        "hs",
+        "--res",
+        "2048x2048",
+        "--builder",
+        "cpu",
+        "--out",
+        o,
+    ]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(err.contains("lower --res"), "{err}");
     let run = cli(&["hemicube", i, "--out", text(&dir.path().join("x.txt"))]);
     assert!(String::from_utf8_lossy(&run.stderr).contains("--out must end in .npy"));
 }
