@@ -34,11 +34,10 @@ use occlusion_gpu::{RayCaster, Scene, VisibilityEngine, VisibilityParams};
 mod lookup;
 mod report;
 
+use crate::repro_visibility::{REPEAT_BELOW_MS, timed};
+
 /// The mesh, relative to the shared data root.
 const MESH: &str = "meshes/garments/dress-victor-iso-draped.obj";
-/// A measurement whose first run is shorter than this is repeated twice more and the median
-/// of the three runs is reported; longer ones are run once.
-const REPEAT_BELOW_MS: f64 = 1000.0;
 /// The thesis's triangle preselection distance (units of the mesh's largest side).
 const PRESELECTION: f32 = 1.0 / 6.0;
 /// Largest planar resolution whose ray maps are kept to compare with the GPU atlas.
@@ -149,25 +148,6 @@ fn error_stats(a: &[f32], b: &[f32]) -> ErrorStats {
         mean: sum / compared.max(1) as f64,
         max,
     }
-}
-
-/// Runs `f` once; when that took less than [`REPEAT_BELOW_MS`], twice more. Returns the last
-/// result, the median time (ms) and the number of runs.
-fn timed<T>(mut f: impl FnMut() -> anyhow::Result<T>) -> anyhow::Result<(T, f64, usize)> {
-    let start = Instant::now();
-    let mut result = f()?;
-    let first = start.elapsed().as_secs_f64() * 1e3;
-    if first >= REPEAT_BELOW_MS {
-        return Ok((result, first, 1));
-    }
-    let mut times = vec![first];
-    for _ in 0..2 {
-        let start = Instant::now();
-        result = f()?;
-        times.push(start.elapsed().as_secs_f64() * 1e3);
-    }
-    times.sort_by(f64::total_cmp);
-    Ok((result, times[1], 3))
 }
 
 /// Pixels where the GPU atlas and the rays disagree.

@@ -27,7 +27,7 @@ use figures::chart::{Series, log_log_svg};
 
 /// A measurement whose first run is shorter than this is repeated twice more and the median
 /// of the three runs is reported; longer ones are run once.
-const REPEAT_BELOW_MS: f64 = 1000.0;
+pub(crate) const REPEAT_BELOW_MS: f64 = 1000.0;
 /// Vertices whose a_i differs by more than this count as "off".
 const OFF_THRESHOLD: f32 = 0.05;
 /// On a software adapter, `query` (one draw per vertex and direction) runs a level only when
@@ -133,7 +133,9 @@ fn error_stats(a: &[f32], b: &[f32]) -> ErrorStats {
 
 /// Runs `f` once; when that took less than [`REPEAT_BELOW_MS`], twice more. Returns the last
 /// result, the median time (ms) and the number of runs.
-fn timed<T>(mut f: impl FnMut() -> anyhow::Result<T>) -> anyhow::Result<(T, f64, usize)> {
+pub(crate) fn timed<T>(
+    mut f: impl FnMut() -> anyhow::Result<T>,
+) -> anyhow::Result<(T, f64, usize)> {
     let start = Instant::now();
     let mut result = f()?;
     let first = start.elapsed().as_secs_f64() * 1e3;

@@ -153,6 +153,21 @@ pub fn visibility(
     VisibilityStage::new(scene, Some(gpu))?.compute(objects, sphere)
 }
 
+/// The radiance of rows `range` times an object's albedo; black where the radiance is not finite
+/// (vertices used by no triangle).
+pub(crate) fn scaled_rows(c: &[Vec3], range: &std::ops::Range<usize>, albedo: Vec3) -> Vec<Vec3> {
+    c[range.clone()]
+        .iter()
+        .map(|v| {
+            if v.is_finite() {
+                *v * albedo
+            } else {
+                Vec3::ZERO
+            }
+        })
+        .collect()
+}
+
 /// Light every object: with M when `visibility` is given, else with M_ij = max(0, n_i·l_j).
 /// Returns the number of vertices lit.
 ///
@@ -171,21 +186,10 @@ pub fn light_objects(
             // c = ρ · (1/π) Σ_j M_ij I_j ω_j.
             let c = crate::lighting::shadowed_radiance(&vis.matrix, sphere, radiance)?;
             for (object, (front, back)) in objects.iter_mut().zip(&vis.rows) {
-                let scale = object.albedo;
-                let take = |range: &std::ops::Range<usize>| -> Vec<Vec3> {
-                    c[range.clone()]
-                        .iter()
-                        .map(|v| {
-                            if v.is_finite() {
-                                *v * scale
-                            } else {
-                                Vec3::ZERO
-                            }
-                        })
-                        .collect()
-                };
-                let f = take(front);
-                let b = back.as_ref().map_or_else(|| f.clone(), take);
+                let f = scaled_rows(&c, front, object.albedo);
+                let b = back
+                    .as_ref()
+                    .map_or_else(|| f.clone(), |b| scaled_rows(&c, b, object.albedo));
                 vertices += f.len();
                 object.front = Some(f);
                 object.back = Some(b);

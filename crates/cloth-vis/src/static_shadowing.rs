@@ -17,6 +17,7 @@ use serde_json::json;
 use crate::Error;
 use crate::object::WorldObject;
 use crate::scene::{Scene, StaticBuilderDesc};
+use crate::shadowing::scaled_rows;
 
 /// Maps and lighting for a run: layout and (for the GPU) the atlas pipeline made once.
 pub struct StaticShadowingStage {
@@ -109,21 +110,11 @@ impl StaticShadowingStage {
         let c = hemicube::lighting::environment_radiance(&maps, env, Vec3::ONE, self.lookup);
         let light_ms = t.elapsed().as_secs_f64() * 1e3;
         for (object, (front, back)) in objects.iter_mut().zip(&rows) {
-            let albedo = object.albedo;
-            let take = |range: &std::ops::Range<usize>| -> Vec<Vec3> {
-                c[range.clone()]
-                    .iter()
-                    .map(|v| {
-                        if v.is_finite() {
-                            *v * albedo
-                        } else {
-                            Vec3::ZERO
-                        }
-                    })
-                    .collect()
-            };
-            let f = take(front);
-            object.back = Some(back.as_ref().map_or_else(|| f.clone(), take));
+            let f = scaled_rows(&c, front, object.albedo);
+            object.back = Some(
+                back.as_ref()
+                    .map_or_else(|| f.clone(), |b| scaled_rows(&c, b, object.albedo)),
+            );
             object.front = Some(f);
         }
         Ok(json!({

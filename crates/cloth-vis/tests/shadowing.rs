@@ -5,56 +5,12 @@
 
 mod common;
 
-use cloth_vis::object::WorldObject;
+use common::{object, sheet};
+
 use cloth_vis::scene::Scene;
 use cloth_vis::shadowing::{light_objects, visibility};
 use glam::Vec3;
 use gpu_context::{GpuContext, GpuOptions};
-
-/// An n×n grid in the xz plane at height y, facing +y (counter-clockwise seen from above).
-fn sheet(n: usize, size: f32, y: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let mut positions = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            let s = size / (n - 1) as f32;
-            positions.push(Vec3::new(
-                i as f32 * s - size / 2.0,
-                y,
-                j as f32 * s - size / 2.0,
-            ));
-        }
-    }
-    let mut triangles = Vec::new();
-    for i in 0..n - 1 {
-        for j in 0..n - 1 {
-            let a = (i * n + j) as u32;
-            let (b, c, d) = (a + 1, a + n as u32, a + n as u32 + 1);
-            triangles.push([a, b, d]);
-            triangles.push([a, d, c]);
-        }
-    }
-    (positions, triangles)
-}
-
-fn object(
-    name: &str,
-    (positions, triangles): (Vec<Vec3>, Vec<[u32; 3]>),
-    two_sided: bool,
-) -> WorldObject {
-    let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
-    WorldObject {
-        name: name.to_owned(),
-        positions,
-        normals,
-        triangles,
-        uvs: None,
-        albedo: Vec3::new(0.5, 0.25, 1.0),
-        two_sided,
-        front: None,
-        back: None,
-        animation: None,
-    }
-}
 
 #[test]
 fn constant_sky_gives_albedo_times_radiance_times_ambient_on_both_sides() {

@@ -4,50 +4,11 @@
 
 mod common;
 
+use common::{object, sheet};
+
 use std::sync::Arc;
 
-use cloth_vis::object::WorldObject;
 use cloth_vis::static_shadowing::StaticShadowingStage;
-use glam::Vec3;
-
-fn sheet(n: usize, size: f32, y: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let s = size / (n - 1) as f32;
-    let positions = (0..n * n)
-        .map(|k| {
-            Vec3::new(
-                (k / n) as f32 * s - size / 2.0,
-                y,
-                (k % n) as f32 * s - size / 2.0,
-            )
-        })
-        .collect();
-    let mut triangles = Vec::new();
-    for i in 0..n - 1 {
-        for j in 0..n - 1 {
-            let a = (i * n + j) as u32;
-            let (b, c, d) = (a + 1, a + n as u32, a + n as u32 + 1);
-            triangles.push([a, b, d]);
-            triangles.push([a, d, c]);
-        }
-    }
-    (positions, triangles)
-}
-
-fn object(name: &str, (positions, triangles): (Vec<Vec3>, Vec<[u32; 3]>)) -> WorldObject {
-    let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
-    WorldObject {
-        name: name.to_owned(),
-        positions,
-        normals,
-        triangles,
-        uvs: None,
-        albedo: Vec3::new(0.5, 0.25, 1.0),
-        two_sided: true,
-        front: None,
-        back: None,
-        animation: None,
-    }
-}
 
 #[test]
 fn constant_sky_gives_albedo_times_radiance_times_open_fraction_on_both_sides() {
@@ -60,8 +21,8 @@ fn constant_sky_gives_albedo_times_radiance_times_open_fraction_on_both_sides() 
     // The lower sheet is two-sided and normals face +y (the winding above); the upper sheet
     // covers its centre.
     let mut objects = vec![
-        object("low", sheet(9, 2.0, 0.0)),
-        object("high", sheet(3, 0.5, 0.3)),
+        object("low", sheet(9, 2.0, 0.0), true),
+        object("high", sheet(3, 0.5, 0.3), true),
     ];
     stage.light(None, &mut objects, &env).unwrap();
     // The reference: the hemicube maps of the same scene, front then back rows.

@@ -17,8 +17,8 @@ use std::time::Instant;
 
 use super::invalid;
 use super::visibility::{
-    DEFAULT_GAMMA, DEFAULT_RENDER_SIZE, MAX_EXPOSURE_EV, MAX_RENDER_SIDE, display_colours,
-    lower_extension, write_glb, write_ply,
+    DEFAULT_GAMMA, DEFAULT_RENDER_SIZE, check_render, display_colours, lower_extension, write_glb,
+    write_ply,
 };
 use cloth_vis::Error;
 use cloth_vis::lighting::environment_rotation;
@@ -156,34 +156,13 @@ fn check_request(
         }),
     };
     if let Some(p) = &request.render {
-        if !matches!(lower_extension(p).as_deref(), Some("png" | "exr")) {
-            return Err(invalid(
-                p,
-                "--render must end in .png (tone-mapped) or .exr (linear radiance)".to_owned(),
-            ));
-        }
-        if gpu.is_none() {
-            return Err(invalid(
-                p,
-                "--render needs a GPU adapter and none was found; a software one is fine \
-                 (Mesa's lavapipe: apt-get install mesa-vulkan-drivers)"
-                    .to_owned(),
-            ));
-        }
-        let [w, h] = request.render_size;
-        if w == 0 || h == 0 || w > MAX_RENDER_SIDE || h > MAX_RENDER_SIDE {
-            return Err(invalid(
-                p,
-                format!("--render-size {w}x{h}: each side must be 1..={MAX_RENDER_SIDE}"),
-            ));
-        }
-        let ev = request.exposure_ev.unwrap_or(0.0);
-        if !(ev.is_finite() && ev.abs() <= MAX_EXPOSURE_EV) {
-            return Err(invalid(
-                p,
-                format!("--exposure {ev} must be finite, within ±{MAX_EXPOSURE_EV} stops"),
-            ));
-        }
+        check_render(
+            p,
+            gpu,
+            request.render_size,
+            DEFAULT_GAMMA,
+            request.exposure_ev,
+        )?;
     }
     if !request.rotation_deg.is_finite() {
         return Err(invalid(

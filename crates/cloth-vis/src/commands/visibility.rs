@@ -168,7 +168,7 @@ enum OutKind {
 
 /// What `--render`'s extension asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum ImageKind {
+pub(super) enum ImageKind {
     Png,
     Exr,
 }
@@ -208,48 +208,13 @@ fn check_request(
     };
     let image_kind = match &request.render {
         None => None,
-        Some(p) => {
-            let kind = match lower_extension(p).as_deref() {
-                Some("png") => ImageKind::Png,
-                Some("exr") => ImageKind::Exr,
-                _ => {
-                    return Err(invalid(
-                        p,
-                        "--render must end in .png (tone-mapped) or .exr (linear radiance)"
-                            .to_owned(),
-                    ));
-                }
-            };
-            if gpu.is_none() {
-                return Err(invalid(
-                    p,
-                    "--render needs a GPU adapter and none was found; a software one is fine \
-                     (Mesa's lavapipe: apt-get install mesa-vulkan-drivers)"
-                        .to_owned(),
-                ));
-            }
-            let [w, h] = request.render_size;
-            if w == 0 || h == 0 || w > MAX_RENDER_SIDE || h > MAX_RENDER_SIDE {
-                return Err(invalid(
-                    p,
-                    format!("--render-size {w}x{h}: each side must be 1..={MAX_RENDER_SIDE}"),
-                ));
-            }
-            if !(request.gamma.is_finite() && request.gamma > 0.0) {
-                return Err(invalid(
-                    p,
-                    format!("--gamma {} must be finite and > 0", request.gamma),
-                ));
-            }
-            let ev = request.exposure_ev.unwrap_or(0.0);
-            if !(ev.is_finite() && ev.abs() <= MAX_EXPOSURE_EV) {
-                return Err(invalid(
-                    p,
-                    format!("--exposure {ev} must be finite, within ±{MAX_EXPOSURE_EV} stops"),
-                ));
-            }
-            Some(kind)
-        }
+        Some(p) => Some(check_render(
+            p,
+            gpu,
+            request.render_size,
+            request.gamma,
+            request.exposure_ev,
+        )?),
     };
     let rotation = request.env_rotation_deg;
     if !rotation.is_finite() {
@@ -267,10 +232,59 @@ fn check_request(
     Ok((out_kind, image_kind))
 }
 
+/// Checks a `--render` request (`path`'s extension, an adapter, the size, gamma and exposure)
+/// before any work; returns what the extension asks for.
+pub(super) fn check_render(
+    path: &Path,
+    gpu: Option<&GpuContext>,
+    [w, h]: [u32; 2],
+    gamma: f32,
+    exposure_ev: Option<f32>,
+) -> Result<ImageKind, Error> {
+    let kind = match lower_extension(path).as_deref() {
+        Some("png") => ImageKind::Png,
+        Some("exr") => ImageKind::Exr,
+        _ => {
+            return Err(invalid(
+                path,
+                "--render must end in .png (tone-mapped) or .exr (linear radiance)".to_owned(),
+            ));
+        }
+    };
+    if gpu.is_none() {
+        return Err(invalid(
+            path,
+            "--render needs a GPU adapter and none was found; a software one is fine \
+             (Mesa's lavapipe: apt-get install mesa-vulkan-drivers)"
+                .to_owned(),
+        ));
+    }
+    if w == 0 || h == 0 || w > MAX_RENDER_SIDE || h > MAX_RENDER_SIDE {
+        return Err(invalid(
+            path,
+            format!("--render-size {w}x{h}: each side must be 1..={MAX_RENDER_SIDE}"),
+        ));
+    }
+    if !(gamma.is_finite() && gamma > 0.0) {
+        return Err(invalid(
+            path,
+            format!("--gamma {gamma} must be finite and > 0"),
+        ));
+    }
+    let ev = exposure_ev.unwrap_or(0.0);
+    if !(ev.is_finite() && ev.abs() <= MAX_EXPOSURE_EV) {
+        return Err(invalid(
+            path,
+            format!("--exposure {ev} must be finite, within ±{MAX_EXPOSURE_EV} stops"),
+        ));
+    }
+    Ok(kind)
+}
+
 /// Largest `--render-size` side (wgpu's guaranteed 2D texture limit).
-pub(super) const MAX_RENDER_SIDE: u32 = 8192;
+const MAX_RENDER_SIDE: u32 = 8192;
 /// Largest `--exposure` magnitude in stops (2^±64 covers every f32 radiance range).
-pub(super) const MAX_EXPOSURE_EV: f32 = 64.0;
+const MAX_EXPOSURE_EV: f32 = 64.0;
 
 /// The one-object scene the request describes: the input as a white one-sided object, the
 /// lightsphere level, the visibility backend and depth resolution, an automatically framed
