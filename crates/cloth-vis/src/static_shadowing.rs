@@ -43,7 +43,11 @@ impl StaticShadowingStage {
         let layout = Arc::new(PixelLayout::new(model, hemicube::FormFactorRule::Exact)?);
         let gpu_builder = match (table.builder, gpu) {
             (StaticBuilderDesc::Cpu, _) | (StaticBuilderDesc::Auto, None) => None,
-            (StaticBuilderDesc::Auto, Some(g)) if g.summary().is_software || !model.is_planar() => {
+            (StaticBuilderDesc::Auto, Some(g))
+                if g.summary().is_software
+                    || !model.is_planar()
+                    || !GpuBuilder::is_supported(g) =>
+            {
                 None
             }
             (_, Some(g)) => Some(GpuBuilder::new(g, layout.clone())?),

@@ -109,6 +109,13 @@ pub struct GpuBuilder {
 }
 
 impl GpuBuilder {
+    /// Whether the adapter can run the atlas (it needs clip distances).
+    pub fn is_supported(gpu: &GpuContext) -> bool {
+        gpu.device
+            .features()
+            .contains(wgpu::Features::CLIP_DISTANCES)
+    }
+
     /// Pipeline and atlas for `layout`.
     ///
     /// # Errors

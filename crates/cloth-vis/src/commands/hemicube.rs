@@ -69,7 +69,8 @@ pub struct HemicubeRequest {
     pub model: Model,
     /// ΔF rule.
     pub rule: FormFactorRule,
-    /// Builder; `None` = GPU on a hardware adapter for HC/SP, rays otherwise.
+    /// Builder; `None` = GPU on a hardware adapter with clip distances for HC/SP, rays
+    /// otherwise.
     pub builder: Option<Builder>,
     /// Preselection distance (rays only), units of the mesh's largest side.
     pub max_distance: Option<f32>,
@@ -109,10 +110,10 @@ pub struct HemicubeSummary {
 }
 
 impl HemicubeSummary {
-    /// `hemicube: MODEL RES x N vertices in T ms (BUILDER)`.
+    /// `hemicube: MODEL RES x N vertices in T ms (BUILDER), B bytes per vertex`.
     pub fn line(&self) -> String {
         format!(
-            "hemicube: {} x {} vertices in {:.1} ms ({}; {} bytes per vertex)",
+            "hemicube: {} x {} vertices in {:.1} ms ({}), {} bytes per vertex",
             self.model.label(),
             self.vertices,
             self.millis,
@@ -291,7 +292,13 @@ pub fn run_hemicube(
     }
     let out_kind = check_request(request, gpu)?;
     let builder = request.builder.unwrap_or(match gpu {
-        Some(g) if !g.summary().is_software && request.model.is_planar() => Builder::Gpu,
+        Some(g)
+            if !g.summary().is_software
+                && request.model.is_planar()
+                && GpuBuilder::is_supported(g) =>
+        {
+            Builder::Gpu
+        }
         _ => Builder::Cpu,
     });
     let scene = one_object_scene(request)?;
