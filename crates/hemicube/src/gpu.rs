@@ -246,6 +246,21 @@ impl GpuBuilder {
         caster: &RayCaster,
         params: &BuildParams,
     ) -> Result<(VisibilityMaps, BuildStats), HemicubeError> {
+        self.build_with_progress(gpu, caster, params, &|_| {})
+    }
+
+    /// [`GpuBuilder::build_with_caster`] calling `progress(n)` after every atlas pass with the
+    /// n vertices it built.
+    ///
+    /// # Errors
+    /// As [`GpuBuilder::build`].
+    pub fn build_with_progress(
+        &self,
+        gpu: &GpuContext,
+        caster: &RayCaster,
+        params: &BuildParams,
+        progress: &(dyn Fn(u64) + Sync),
+    ) -> Result<(VisibilityMaps, BuildStats), HemicubeError> {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let frames = frames_of(caster);
         let offset = params.offset_relative * caster.diagonal();
@@ -346,6 +361,7 @@ impl GpuBuilder {
             stats.passes += 1;
             stats.samples += (batch.len() * self.layout.len()) as u64;
             self.unpack(&atlas, atlas_w as usize, batch, &mut maps);
+            progress(batch.len() as u64);
         }
         Ok((maps, stats))
     }

@@ -62,4 +62,4 @@ pub use layout::{
 pub use lighting::{CubeMap, EnvLookup, PointLight, PointLighting, PointVisibility};
 pub use maps::{VertexFrame, VisibilityMaps};
 pub use measured::MeasuredChannel;
-pub use rays::{BuildParams, BuildStats, build_with_caster, build_with_rays};
+pub use rays::{BuildParams, BuildStats, build_with_caster, build_with_progress, build_with_rays};

@@ -103,6 +103,17 @@ pub fn build_with_caster(
     layout: Arc<PixelLayout>,
     params: &BuildParams,
 ) -> (VisibilityMaps, BuildStats) {
+    build_with_progress(caster, layout, params, &|_| {})
+}
+
+/// [`build_with_caster`] calling `progress(n)` as every n further vertices are done (from the
+/// worker threads: a progress bar's `inc`).
+pub fn build_with_progress(
+    caster: &RayCaster,
+    layout: Arc<PixelLayout>,
+    params: &BuildParams,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (VisibilityMaps, BuildStats) {
     let frames = frames_of(caster);
     let offset = params.offset_relative * caster.diagonal();
     let max_t = params
@@ -126,6 +137,7 @@ pub fn build_with_caster(
                     out[p / 64] |= 1 << (p % 64);
                 }
             }
+            progress(1);
             directions.len() as u64
         })
         .sum();

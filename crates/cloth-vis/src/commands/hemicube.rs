@@ -260,10 +260,13 @@ fn build_maps(
 ) -> Result<VisibilityMaps, Error> {
     let mut params = BuildParams::default();
     params.max_distance = request.max_distance;
-    Ok(match (builder, gpu) {
+    // A bar on stderr (hidden when it is not a terminal) for builds over a second.
+    let bar = cloth_vis::run::progress_bar(true, caster.receiver_count() as u64, "visibility maps");
+    let progress = |n: u64| bar.inc(n);
+    let maps = match (builder, gpu) {
         (Builder::Gpu, Some(gpu)) => {
             GpuBuilder::new(gpu, layout)?
-                .build_with_caster(gpu, caster, &params)?
+                .build_with_progress(gpu, caster, &params, &progress)?
                 .0
         }
         (Builder::Gpu, None) => {
@@ -274,8 +277,10 @@ fn build_maps(
                     .to_owned(),
             ));
         }
-        (Builder::Cpu, _) => hemicube::build_with_caster(caster, layout, &params).0,
-    })
+        (Builder::Cpu, _) => hemicube::build_with_progress(caster, layout, &params, &progress).0,
+    };
+    bar.finish_and_clear();
+    Ok(maps)
 }
 
 /// Runs the request.
