@@ -17,15 +17,13 @@ use std::time::Instant;
 
 use super::invalid;
 use super::visibility::{
-    DEFAULT_GAMMA, DEFAULT_RENDER_SIZE, check_render, display_colours, lower_extension, write_glb,
-    write_ply,
+    DEFAULT_GAMMA, DEFAULT_RENDER_SIZE, check_render, display_colours, display_scene,
+    lower_extension, write_glb, write_ply,
 };
 use cloth_vis::Error;
 use cloth_vis::lighting::environment_rotation;
 use cloth_vis::run::render_still_image;
-use cloth_vis::scene::{
-    AutoKeyword, BackgroundDesc, BackgroundKeyword, ExposureDesc, Scene, ToneDesc,
-};
+use cloth_vis::scene::Scene;
 use glam::Vec3;
 use gpu_context::GpuContext;
 use hemicube::lighting::{PointLighting, add_point_lights, environment_radiance};
@@ -229,25 +227,14 @@ fn check_request(
 /// The one-object scene for loading and rendering: the input as a white object, clamp-then-gamma
 /// PNGs, the environment as backdrop.
 fn one_object_scene(request: &HemicubeRequest) -> Result<Scene, Error> {
-    let mut scene = Scene::one_object(&request.input, "cloth-vis hemicube")?;
-    if let Some(topology) = &request.topology {
-        scene.objects[0].topology = Some(
-            topology
-                .to_str()
-                .ok_or_else(|| invalid(topology, "the path is not valid UTF-8".to_owned()))?
-                .to_owned(),
-        );
-    }
-    scene.camera.width = request.render_size[0];
-    scene.camera.height = request.render_size[1];
-    scene.output.exposure = match request.exposure_ev {
-        Some(ev) => ExposureDesc::Fixed(ev),
-        None => ExposureDesc::Auto(AutoKeyword::Auto),
-    };
-    scene.output.tone = ToneDesc::Clamp;
-    scene.output.gamma = DEFAULT_GAMMA;
-    scene.output.background = BackgroundDesc::Named(BackgroundKeyword::Environment);
-    Ok(scene)
+    display_scene(
+        &request.input,
+        request.topology.as_deref(),
+        "cloth-vis hemicube",
+        request.render_size,
+        request.exposure_ev,
+        DEFAULT_GAMMA,
+    )
 }
 
 /// Builds the maps with the chosen builder.

@@ -292,15 +292,14 @@ const MAX_EXPOSURE_EV: f32 = 64.0;
 /// clamp-then-gamma with `--gamma`, exposure `--exposure` or automatic from the object's
 /// pixels; the backdrop when an environment is given, else black).
 fn one_object_scene(request: &VisibilityRequest) -> Result<Scene, Error> {
-    let mut scene = Scene::one_object(&request.input, "cloth-vis visibility")?;
-    if let Some(topology) = &request.topology {
-        scene.objects[0].topology = Some(
-            topology
-                .to_str()
-                .ok_or_else(|| invalid(topology, "the path is not valid UTF-8".to_owned()))?
-                .to_owned(),
-        );
-    }
+    let mut scene = display_scene(
+        &request.input,
+        request.topology.as_deref(),
+        "cloth-vis visibility",
+        request.render_size,
+        request.exposure_ev,
+        request.gamma,
+    )?;
     scene.lighting.level = request.level;
     scene.visibility.backend = match request.backend {
         None => VisibilityBackendDesc::Auto,
@@ -309,14 +308,38 @@ fn one_object_scene(request: &VisibilityRequest) -> Result<Scene, Error> {
         Some(Backend::Query) => VisibilityBackendDesc::Query,
     };
     scene.visibility.depth_resolution = request.depth_resolution;
-    scene.camera.width = request.render_size[0];
-    scene.camera.height = request.render_size[1];
-    scene.output.exposure = match request.exposure_ev {
+    Ok(scene)
+}
+
+/// The one-object scene a per-vertex command displays: `input` (with `topology` for a point
+/// cache) as a white object, an automatically framed camera of `render_size`, the seed's
+/// clamp-then-gamma PNGs with exposure `exposure_ev` (automatic when `None`), the environment
+/// as backdrop.
+pub(super) fn display_scene(
+    input: &Path,
+    topology: Option<&Path>,
+    origin: &str,
+    render_size: [u32; 2],
+    exposure_ev: Option<f32>,
+    gamma: f32,
+) -> Result<Scene, Error> {
+    let mut scene = Scene::one_object(input, origin)?;
+    if let Some(topology) = topology {
+        scene.objects[0].topology = Some(
+            topology
+                .to_str()
+                .ok_or_else(|| invalid(topology, "the path is not valid UTF-8".to_owned()))?
+                .to_owned(),
+        );
+    }
+    scene.camera.width = render_size[0];
+    scene.camera.height = render_size[1];
+    scene.output.exposure = match exposure_ev {
         Some(ev) => ExposureDesc::Fixed(ev),
         None => ExposureDesc::Auto(AutoKeyword::Auto),
     };
     scene.output.tone = ToneDesc::Clamp;
-    scene.output.gamma = request.gamma;
+    scene.output.gamma = gamma;
     scene.output.background = BackgroundDesc::Named(BackgroundKeyword::Environment);
     Ok(scene)
 }
