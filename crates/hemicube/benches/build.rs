@@ -8,15 +8,21 @@
 //! The thesis's seconds (Celeron 800 MHz + TNT2), fastest method per configuration: HC 8² 15.2,
 //! HC 16² 17.0, SP 8² 3.1, SP 16² 3.7, HS 16×4 7.2, HS 32×8 20.6. Skips with a message when
 //! `../shared/data` is missing. Run with `cargo bench -p hemicube --bench build`.
+//!
+//! Groups: `rays` (the builder: fans of 64 rays per origin), `rays-preselect-1_6` (the same
+//! cut at 1/6 of the mesh size, the distance of the thesis's fastest rows), `single-rays`
+//! (one BVH traversal per pixel, the builder before fans), `gpu`.
 
 use std::sync::Arc;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use hemicube::{
-    BuildParams, FormFactorRule, GpuBuilder, Model, PixelLayout, RingSpacing, build_with_caster,
+    BuildParams, FormFactorRule, GpuBuilder, Model, PixelLayout, RingSpacing, VertexFrame,
+    build_with_caster,
 };
-use occlusion_gpu::{RayCaster, Scene, SceneObject};
+use occlusion_gpu::{RayCache, RayCaster, Scene, SceneObject};
+use rayon::prelude::*;
 
 const DRESS: &str = "meshes/garments/dress-victor-iso-draped.obj";
 
@@ -67,15 +73,10 @@ fn rays(c: &mut Criterion) {
     let caster = RayCaster::new(&scene).expect("valid scene");
     let mut group = c.benchmark_group("hemicube/rays/dress");
     group.sample_size(10);
-    for model in [
-        Model::Hemicube { res: 8 },
-        Model::Hemicube { res: 16 },
-        sp(8),
-        sp(16),
-        hs(16, 4),
-        hs(32, 8),
-        Model::Hemicube { res: 64 },
-    ] {
+    for model in table_models()
+        .into_iter()
+        .chain([Model::Hemicube { res: 64 }])
+    {
         let layout = Arc::new(PixelLayout::new(model, FormFactorRule::Exact).unwrap());
         let rays = (caster.receiver_count() * layout.len()) as u64;
         group.throughput(Throughput::Elements(rays));
@@ -83,6 +84,75 @@ fn rays(c: &mut Criterion) {
             b.iter(|| build_with_caster(&caster, layout.clone(), &BuildParams::default()));
         });
     }
+    group.finish();
+    // The thesis's fastest rows use triangle preselection at 1/6 of the mesh size: the same
+    // configuration here is a ray cut at that distance.
+    let mut group = c.benchmark_group("hemicube/rays-preselect-1_6/dress");
+    group.sample_size(10);
+    let mut preselect = BuildParams::default();
+    preselect.max_distance = Some(1.0 / 6.0);
+    for model in table_models() {
+        let layout = Arc::new(PixelLayout::new(model, FormFactorRule::Exact).unwrap());
+        group.throughput(Throughput::Elements(
+            (caster.receiver_count() * layout.len()) as u64,
+        ));
+        group.bench_function(model.label(), |b| {
+            b.iter(|| build_with_caster(&caster, layout.clone(), &preselect));
+        });
+    }
+    group.finish();
+    // The peer inside this workspace: one CWBVH traversal per ray (`RayCaster::occluded`,
+    // what the builder did before fans), same pixels, same answers.
+    let mut group = c.benchmark_group("hemicube/single-rays/dress");
+    group.sample_size(10);
+    for model in table_models() {
+        let layout = Arc::new(PixelLayout::new(model, FormFactorRule::Exact).unwrap());
+        group.throughput(Throughput::Elements(
+            (caster.receiver_count() * layout.len()) as u64,
+        ));
+        group.bench_function(model.label(), |b| {
+            b.iter(|| single_rays(&caster, &layout));
+        });
+    }
+}
+
+/// The six configurations of Table 4.1.
+fn table_models() -> [Model; 6] {
+    [
+        Model::Hemicube { res: 8 },
+        Model::Hemicube { res: 16 },
+        sp(8),
+        sp(16),
+        hs(16, 4),
+        hs(32, 8),
+    ]
+}
+
+/// Open pixels of every vertex by one single-ray query per pixel (frames from normals, the
+/// builder's origin offset).
+fn single_rays(caster: &RayCaster, layout: &PixelLayout) -> usize {
+    let offset = BuildParams::default().offset_relative * caster.diagonal();
+    let receivers: Vec<(Vec3, Vec3)> = caster.receivers().collect();
+    receivers
+        .par_iter()
+        .filter(|(_, n)| *n != Vec3::ZERO)
+        .map(|&(p, n)| {
+            let frame = VertexFrame::from_normal(n);
+            let mut cache = RayCache::default();
+            layout
+                .directions()
+                .iter()
+                .filter(|d| {
+                    !caster.occluded(
+                        p + n * offset,
+                        frame.to_world(**d),
+                        f32::INFINITY,
+                        &mut cache,
+                    )
+                })
+                .count()
+        })
+        .sum()
 }
 
 fn gpu(c: &mut Criterion) {

@@ -6,6 +6,14 @@
 //! (cloth is open and two-sided). Works for all three models (§4.3.4: "ray tracing works for
 //! all"), and is the accuracy reference of the GPU builder, which samples the same directions.
 //!
+//! The rays of one vertex share their origin, so they are cast as *fans*
+//! ([`occlusion_gpu::RayFan`]): the layout's pixels are split once into compact groups of
+//! four neighbouring directions (recursive median splits) and 64 per fan, and each fan walks
+//! the BVH together, one SIMD test per group and node, with a common-origin triangle test.
+//! Every pixel is the answer of [`RayCaster::occluded`] (a test asserts it); on the dress this
+//! is 3.4–4.1× faster than one traversal per ray (`benches/build.rs`: HC 16² of the dress in
+//! 89 ms against 340 ms; 2 of its 3.5 M pixels differ, both within rounding of an edge).
+//!
 //! [`BuildParams::max_distance`] is the seed's *triangle preselection* (Table 4.1, "distance
 //! 1/6 ums"): occluders farther than that many units of the mesh's largest bounding-box side
 //! are ignored. With a BVH the preselection is only a shorter ray: it saves the far part of
@@ -14,7 +22,7 @@
 use std::sync::Arc;
 
 use glam::{Mat3, Vec3};
-use occlusion_gpu::{RayCache, RayCaster, Scene};
+use occlusion_gpu::{FAN_GROUP, FAN_SIZE, RayCaster, RayFan, Scene};
 use rayon::prelude::*;
 
 use crate::HemicubeError;
@@ -120,28 +128,95 @@ pub fn build_with_progress(
         .max_distance
         .map_or(f32::INFINITY, |d| d * largest_side(caster));
     let receivers: Vec<(Vec3, Vec3)> = caster.receivers().collect();
-    let directions = layout.directions().to_vec();
+    let groups = fan_groups(layout.directions());
+    // Each fan in the vertex frame, built once; per vertex it is only rotated.
+    let templates: Vec<RayFan> = groups
+        .iter()
+        .map(|group| {
+            let mut fan = RayFan::new();
+            for quad in group.chunks(FAN_GROUP) {
+                for &p in quad.iter().filter(|&&p| p != u32::MAX) {
+                    fan.push(layout.directions()[p as usize]);
+                }
+                fan.finish_group();
+            }
+            fan
+        })
+        .collect();
+    let pixels = layout.len() as u64;
     let mut maps = VisibilityMaps::new(layout, frames.clone());
     let (bits, words) = maps.words_mut();
     let samples: u64 = bits
         .par_chunks_mut(words)
         .zip(frames.par_iter())
         .zip(receivers.par_iter())
-        .map(|((out, frame), &(position, normal))| {
+        .map_init(RayFan::new, |fan, ((out, frame), &(position, normal))| {
             let Some(frame) = frame else { return 0 };
             let m = Mat3::from_quat(frame.rotation);
             let origin = position + normal * offset;
-            let mut cache = RayCache::default();
-            for (p, d) in directions.iter().enumerate() {
-                if !caster.occluded(origin, m * *d, max_t, &mut cache) {
+            for (group, template) in groups.iter().zip(&templates) {
+                template.rotate_into(m, fan);
+                let mut open = caster.unoccluded_fan(origin, fan, fan.full_mask(), max_t);
+                while open != 0 {
+                    let p = group[open.trailing_zeros() as usize] as usize;
+                    open &= open - 1;
                     out[p / 64] |= 1 << (p % 64);
                 }
             }
             progress(1);
-            directions.len() as u64
+            pixels
         })
         .sum();
     (maps, BuildStats { samples, passes: 0 })
+}
+
+/// The pixels split into fans: groups of at most [`FAN_GROUP`] close directions (one SIMD
+/// vector of the traversal), halved recursively at the median of the widest coordinate so
+/// each group is a compact cone, and [`FAN_SIZE`] / [`FAN_GROUP`] neighbouring groups per
+/// fan. `u32::MAX` marks the unused lanes at the end of a short group.
+fn fan_groups(directions: &[Vec3]) -> Vec<Vec<u32>> {
+    fn split(directions: &[Vec3], mut pixels: Vec<u32>, out: &mut Vec<Vec<u32>>) {
+        if pixels.len() <= FAN_GROUP {
+            out.push(pixels);
+            return;
+        }
+        let (lo, hi) = pixels
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+                let d = directions[p as usize];
+                (lo.min(d), hi.max(d))
+            });
+        let axis = (hi - lo).max_position();
+        pixels.sort_by(|&a, &b| {
+            directions[a as usize][axis].total_cmp(&directions[b as usize][axis])
+        });
+        // Split into whole blocks where possible, so no block is left nearly empty.
+        let blocks = pixels.len().div_ceil(FAN_GROUP);
+        let cut = blocks.div_ceil(2) * pixels.len() / blocks;
+        let right = pixels.split_off(cut);
+        split(directions, pixels, out);
+        split(directions, right, out);
+    }
+    let mut blocks = Vec::new();
+    split(
+        directions,
+        (0..directions.len() as u32).collect(),
+        &mut blocks,
+    );
+    blocks
+        .chunks(FAN_SIZE / FAN_GROUP)
+        .map(|fan| {
+            fan.iter()
+                .flat_map(|block| {
+                    let pad = FAN_GROUP - block.len();
+                    block
+                        .iter()
+                        .copied()
+                        .chain(std::iter::repeat_n(u32::MAX, pad))
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// The largest side of the scene's bounding box (the seed's "unit of mesh size").

@@ -19,6 +19,26 @@ use occlusion_gpu::{RayCaster, Scene};
 fn both(scene: &Scene, model: Model, band: f64) -> VisibilityMaps {
     let layout = layout(model);
     let (rays, _) = build_with_rays(scene, layout.clone(), &BuildParams::default()).unwrap();
+    // The builder traces fans of 64 pixels; each pixel must equal the single-ray query.
+    let caster = RayCaster::new(scene).unwrap();
+    let offset = occlusion_gpu::DEFAULT_OFFSET_RELATIVE * caster.diagonal();
+    let mut single = 0;
+    for (v, (position, normal)) in caster.receivers().enumerate() {
+        let Some(frame) = rays.frame(v) else { continue };
+        for (p, d) in layout.directions().iter().enumerate() {
+            let blocked = caster.occluded(
+                position + normal * offset,
+                frame.to_world(*d),
+                f32::INFINITY,
+                &mut Default::default(),
+            );
+            single += usize::from(blocked == rays.is_open(v, p));
+        }
+    }
+    assert!(
+        single as f64 <= 1e-4 * (rays.len() * layout.len()) as f64,
+        "fans and single rays differ on {single} pixels"
+    );
     if let Some(gpu) = gpu_context::testing::gpu_or_skip() {
         let builder = GpuBuilder::new(&gpu, layout.clone()).unwrap();
         let (raster, _) = builder.build(&gpu, scene, &BuildParams::default()).unwrap();

@@ -54,7 +54,7 @@ pub const DEFAULT_OFFSET_RELATIVE: f32 = 1e-4;
 /// octahedron's axis-aligned directions over axis-aligned geometry do exactly that). Tuned on
 /// the sphere-over-plane test against f64 brute force; it only ever adds occlusion within
 /// 1e-6 of an edge.
-const EDGE_TOLERANCE: f32 = 1e-6;
+pub(crate) const EDGE_TOLERANCE: f32 = 1e-6;
 
 /// How the `cpu` backend traverses its BVH. Both are exact and give the same M.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -293,34 +293,11 @@ struct PacketTracer {
 
 impl PacketTracer {
     fn new(prepared: &Prepared) -> Self {
-        let tris = scene_triangles(prepared);
-        if tris.is_empty() {
-            return Self {
-                nodes: Vec::new(),
-                triangles: Vec::new(),
-            };
-        }
-        let mut params = BvhBuildParams::medium_build();
-        params.max_prims_per_leaf = PACKET_LEAF_SIZE;
-        let bvh =
-            obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
-        let triangles = bvh
-            .primitive_indices
+        let (nodes, tris) = padded_bvh2(prepared, BvhBuildParams::medium_build(), PACKET_LEAF_SIZE);
+        let triangles = tris
             .iter()
-            .map(|&i| {
-                let t = &tris[i as usize];
-                EdgeTriangle::new([t.v0.into(), t.v1.into(), t.v2.into()])
-            })
+            .map(|t| EdgeTriangle::new([t.v0.into(), t.v1.into(), t.v2.into()]))
             .collect();
-        // Pad every box a little, so the slab test never drops a ray that the triangle test
-        // (with its EDGE_TOLERANCE) would count as a hit on the box's boundary.
-        let absolute = 1e-6 * prepared.diagonal;
-        let mut nodes = bvh.nodes;
-        for node in &mut nodes {
-            let pad = Vec3A::splat(absolute + 1e-5 * (node.aabb.max - node.aabb.min).max_element());
-            node.aabb.min -= pad;
-            node.aabb.max += pad;
-        }
         Self { nodes, triangles }
     }
 
@@ -540,6 +517,38 @@ fn scatter_chunks(
 }
 
 /// The scene's triangles as `obvhs` takes them (degenerate ones included: they never hit).
+/// A binary BVH (`obvhs`'s PLOC build with `quality`'s settings, at most `leaf_size` triangles
+/// per leaf) over the
+/// scene's triangles, with every box padded a little so that the slab test never drops a ray
+/// that the triangle test (with its [`EDGE_TOLERANCE`]) counts as a hit on the box's boundary;
+/// the triangles come back in leaf order. Empty for a scene without triangles.
+pub(crate) fn padded_bvh2(
+    prepared: &Prepared,
+    quality: BvhBuildParams,
+    leaf_size: u32,
+) -> (Vec<obvhs::bvh2::node::Bvh2Node>, Vec<Triangle>) {
+    let tris = scene_triangles(prepared);
+    if tris.is_empty() {
+        return (Vec::new(), Vec::new());
+    }
+    let mut params = quality;
+    params.max_prims_per_leaf = leaf_size;
+    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
+    let ordered = bvh
+        .primitive_indices
+        .iter()
+        .map(|&i| tris[i as usize])
+        .collect();
+    let absolute = 1e-6 * prepared.diagonal;
+    let mut nodes = bvh.nodes;
+    for node in &mut nodes {
+        let pad = Vec3A::splat(absolute + 1e-5 * (node.aabb.max - node.aabb.min).max_element());
+        node.aabb.min -= pad;
+        node.aabb.max += pad;
+    }
+    (nodes, ordered)
+}
+
 fn scene_triangles(prepared: &Prepared) -> Vec<Triangle> {
     prepared
         .triangles

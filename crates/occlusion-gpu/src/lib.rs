@@ -42,6 +42,13 @@
 //! A single rigidly rotating object needs no recompute: [`RigidLighting`] looks the
 //! environment up in the rotated light directions (§6).
 //!
+//! Callers that cast their own rays (the `hemicube` crate's exact maps, its point-light
+//! tests) use [`RayCaster`] on the same prepared scene: one ray at a time
+//! ([`RayCaster::occluded`]), or fans of up to 64 rays from one origin
+//! ([`RayCaster::unoccluded_fan`], [`RayFan`]) that walk a binary BVH together with one SIMD
+//! test per group of four lanes and a common-origin triangle test — the same answers, 3.4–4.1×
+//! faster on a hemicube's pixels.
+//!
 //! Several objects with transforms occlude each other ([`Scene`], [`SceneObject`]); only
 //! receiver objects get matrix rows, in object and vertex order. A vertex with a zero normal
 //! (used by no triangle) has an all-zero row and a_i = c_i = NaN.
@@ -77,6 +84,7 @@
 mod cpu;
 mod engine;
 mod error;
+mod fan;
 mod filter;
 mod gpu;
 mod level;
@@ -88,6 +96,7 @@ mod scene;
 pub use cpu::{CpuMethod, CpuParams, DEFAULT_OFFSET_RELATIVE};
 pub use engine::{Backend, VisibilityEngine, VisibilityParams};
 pub use error::OcclusionError;
+pub use fan::{FAN_GROUP, FAN_SIZE, RayFan};
 pub use filter::{
     Camera, DEFAULT_FILTER_THRESHOLD_FRACTION, FilterParams, FilterThreshold, FilteredVisibility,
     FrameStats, TriangleIdRenderer, TriangleSet, TriangleVisibility, VertexFilter, triangle_rows,
