@@ -157,7 +157,10 @@ impl VisibilityMaps {
         (0..self.len())
             .map(|i| match self.frames[i] {
                 None => f32::NAN,
-                Some(_) => self.open_pixels(i).map(|p| f64::from(ff[p])).sum::<f64>() as f32,
+                // `+ 0.0`: an empty f64 sum is −0.0, and a closed vertex should read 0.
+                Some(_) => {
+                    (self.open_pixels(i).map(|p| f64::from(ff[p])).sum::<f64>() + 0.0) as f32
+                }
             })
             .collect()
     }
