@@ -27,7 +27,7 @@
 use std::sync::Arc;
 
 use glam::{Mat3, Vec3};
-use occlusion_gpu::{FAN_GROUP, FAN_SIZE, RayCaster, RayFan, Scene};
+use occlusion_gpu::{RayCaster, RayFan, Scene, fan_groups};
 use rayon::prelude::*;
 
 use crate::HemicubeError;
@@ -137,16 +137,7 @@ pub fn build_with_progress(
     // Each fan in the vertex frame, built once; per vertex it is only rotated.
     let templates: Vec<RayFan> = groups
         .iter()
-        .map(|group| {
-            let mut fan = RayFan::new();
-            for quad in group.chunks(FAN_GROUP) {
-                for &p in quad.iter().filter(|&&p| p != u32::MAX) {
-                    fan.push(layout.directions()[p as usize]);
-                }
-                fan.finish_group();
-            }
-            fan
-        })
+        .map(|group| RayFan::from_group(layout.directions(), group))
         .collect();
     let pixels = layout.len() as u64;
     let mut maps = VisibilityMaps::new(layout, frames.clone());
@@ -173,56 +164,6 @@ pub fn build_with_progress(
         })
         .sum();
     (maps, BuildStats { samples, passes: 0 })
-}
-
-/// The pixels split into fans: groups of at most [`FAN_GROUP`] close directions (one SIMD
-/// vector of the traversal), halved recursively at the median of the widest coordinate so
-/// each group is a compact cone, and [`FAN_SIZE`] / [`FAN_GROUP`] neighbouring groups per
-/// fan. `u32::MAX` marks the unused lanes at the end of a short group.
-fn fan_groups(directions: &[Vec3]) -> Vec<Vec<u32>> {
-    fn split(directions: &[Vec3], mut pixels: Vec<u32>, out: &mut Vec<Vec<u32>>) {
-        if pixels.len() <= FAN_GROUP {
-            out.push(pixels);
-            return;
-        }
-        let (lo, hi) = pixels
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
-                let d = directions[p as usize];
-                (lo.min(d), hi.max(d))
-            });
-        let axis = (hi - lo).max_position();
-        // Split into whole groups where possible, so no group is left nearly empty.
-        let groups = pixels.len().div_ceil(FAN_GROUP);
-        let cut = groups.div_ceil(2) * pixels.len() / groups;
-        // A partition at the cut, not a sort: O(n) per level (HC 1024² has 3 M pixels).
-        pixels.select_nth_unstable_by(cut, |&a, &b| {
-            directions[a as usize][axis].total_cmp(&directions[b as usize][axis])
-        });
-        let right = pixels.split_off(cut);
-        split(directions, pixels, out);
-        split(directions, right, out);
-    }
-    let mut groups = Vec::new();
-    split(
-        directions,
-        (0..directions.len() as u32).collect(),
-        &mut groups,
-    );
-    groups
-        .chunks(FAN_SIZE / FAN_GROUP)
-        .map(|fan| {
-            fan.iter()
-                .flat_map(|group| {
-                    let pad = FAN_GROUP - group.len();
-                    group
-                        .iter()
-                        .copied()
-                        .chain(std::iter::repeat_n(u32::MAX, pad))
-                })
-                .collect()
-        })
-        .collect()
 }
 
 /// The largest side of the scene's bounding box (the seed's "unit of mesh size").

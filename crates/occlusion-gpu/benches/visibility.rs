@@ -2,7 +2,8 @@
 //! k = 6, 18, 66, 258, 1026 (paper 000 Table 1, time1: 445, 1082, 3606, 13715, 60304 ms on a
 //! Radeon 9800 XT in 2005).
 //!
-//! * `visibility/cpu/bunny`: the default packet traversal at every k, throughput = rays cast
+//! * `visibility/cpu/bunny`: the packet and the fan traversals at every k (the default,
+//!   `CpuMethod::Auto`, runs packets below k = 128 and fans above), throughput = rays cast
 //!   after n·l culling; and the single-ray traversal at k = 258 for the ratio.
 //! * `visibility/depth/bunny`: the `depth` backend at 1024² on the available adapter,
 //!   throughput = vertex-direction tests.
@@ -58,6 +59,9 @@ fn cpu(c: &mut Criterion) {
         run(CpuMethod::Packets, level);
     }
     run(CpuMethod::SingleRays, 3);
+    for level in LEVELS {
+        run(CpuMethod::Fans, level);
+    }
     group.finish();
 }
 

@@ -6,24 +6,32 @@
 //! the scene's bounding-box diagonal along its normal, to infinity, with a Möller–Trumbore
 //! triangle test in f32 on coordinates centred on the scene (so a 1e5 offset costs no
 //! precision). Receiver rows are visited in Morton (Z) order of their positions, in chunks of
-//! 64 spatial neighbours per rayon task. Two traversals, both exact ([`CpuMethod`]):
+//! 64 spatial neighbours per rayon task. Three traversals, all exact ([`CpuMethod`]):
 //!
-//! * [`CpuMethod::Packets`] (default): the rays of one chunk towards one direction l_j are
-//!   parallel and start close together, so they walk a binary BVH together: a node is
-//!   skipped outright when no ray of the family o + t·l_j (o in the chunk's origin box)
-//!   can meet it, otherwise each live ray of a 64-bit mask is slab-tested; a ray leaves the
-//!   mask at its first hit. This is the CPU counterpart of the seed's per-direction pass
-//!   (paper 000 §3.2), without its resolution limit.
+//! * [`CpuMethod::Packets`]: the rays of one chunk towards one direction l_j are parallel and
+//!   start close together, so they walk a binary BVH together: a node is skipped outright when
+//!   no ray of the family o + t·l_j (o in the chunk's origin box) can meet it, otherwise each
+//!   live ray of a 64-bit mask is slab-tested; a ray leaves the mask at its first hit. This is
+//!   the CPU counterpart of the seed's per-direction pass (paper 000 §3.2), without its
+//!   resolution limit.
+//! * [`CpuMethod::Fans`]: the rays of one vertex share its origin, so its directions (split
+//!   once into compact fans of 64, [`fan_groups`]) walk the BVH together, lanes below the
+//!   tangent plane masked off, with a common-origin triangle test (the `fan` module).
 //! * [`CpuMethod::SingleRays`]: one any-hit traversal per ray of `obvhs`'s compressed 8-wide
 //!   BVH (CWBVH), with a per-direction shadow cache (the last blocking triangle of the chunk
-//!   is tested first). Kept as the independent cross-check: a test asserts both give the
+//!   is tested first). Kept as the independent cross-check: a test asserts all three give the
 //!   same M.
 //!
-//! Measured on the full bunny at k = 258 (4.49 M rays, 84 % of which escape and so must
-//! walk the tree to its end): packets take about 0.75× the CPU time of single rays. A
-//! per-direction uniform grid of the projected triangles was also tried and dropped: its
-//! per-direction fill (∝ triangles × k) cost more than the rays it saved (1.7× slower than
-//! single rays). Numbers in `benches/visibility.rs`.
+//! [`CpuMethod::Auto`] (the default) takes fans when a call computes at least
+//! [`FAN_MIN_COLUMNS`] columns and packets below. Measured on the full bunny (35,947
+//! vertices, BVH build included, `benches/visibility.rs`): packets 35.6 / 58.9 / 154 / 502 /
+//! 1,818 ms at k = 6 / 18 / 66 / 258 / 1026, fans 44.1 / 71.8 / 158 / 417 / 1,133 ms, single
+//! rays 734 ms at k = 258. With few directions a vertex's fan is nearly empty and the
+//! per-fan set-up dominates; with many, the shared origin pays. Same M: at k = 258 no entry
+//! of the 9.3 M differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing
+//! rays). A per-direction uniform grid of the projected triangles was also tried and dropped:
+//! its per-direction fill (∝ triangles × k) cost more than the rays it saved (1.7× slower
+//! than single rays).
 //!
 //! BVH crate: `obvhs` 0.4 over `bvh` 0.13. `bvh` is a binary BVH on nalgebra whose
 //! traversal collects candidate shapes per ray; `obvhs` builds BVHs by PLOC with reinsertion
@@ -41,6 +49,7 @@ use obvhs::ray::Ray;
 use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 
+use crate::fan::{FanTracer, RayFan, fan_groups};
 use crate::matrix::WORD_BITS;
 use crate::scene::Prepared;
 
@@ -56,14 +65,36 @@ pub const DEFAULT_OFFSET_RELATIVE: f32 = 1e-4;
 /// 1e-6 of an edge.
 pub(crate) const EDGE_TOLERANCE: f32 = 1e-6;
 
-/// How the `cpu` backend traverses its BVH. Both are exact and give the same M.
+/// How the `cpu` backend traverses its BVH. All are exact and give the same M (up to rays
+/// within rounding of a triangle edge).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum CpuMethod {
-    /// Packets of up to 64 parallel rays through a binary BVH (the default, faster).
+    /// Fans when a call computes at least [`FAN_MIN_COLUMNS`] columns, packets below (the
+    /// default: the faster of the two on either side).
     #[default]
+    Auto,
+    /// Packets of up to 64 parallel rays through a binary BVH (faster for k ≤ 66).
     Packets,
     /// One traversal per ray of an 8-wide compressed BVH, with a shadow cache.
     SingleRays,
+    /// Fans: each vertex's directions in fans of up to 64 from its origin (faster for
+    /// k ≥ 258).
+    Fans,
+}
+
+/// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 66 (packets
+/// 3 % faster) and k = 258 (fans 1.2× faster).
+pub const FAN_MIN_COLUMNS: usize = 128;
+
+impl CpuMethod {
+    /// The traversal this method runs for a call computing `columns` columns.
+    pub fn resolve(self, columns: usize) -> Self {
+        match self {
+            Self::Auto if columns >= FAN_MIN_COLUMNS => Self::Fans,
+            Self::Auto => Self::Packets,
+            other => other,
+        }
+    }
 }
 
 /// Tuning knobs of the `cpu` backend.
@@ -233,6 +264,15 @@ pub(crate) fn compute_columns(
         TracerKind::Packets(t) => {
             packet_columns(prepared, t, &dirs, columns, offset, bits, words_per_row)
         }
+        TracerKind::Fans(t) => fan_columns(
+            prepared,
+            t,
+            directions,
+            columns,
+            offset,
+            bits,
+            words_per_row,
+        ),
         TracerKind::SingleRays(t) => {
             bvh_columns(prepared, t, &dirs, columns, offset, bits, words_per_row)
         }
@@ -251,13 +291,20 @@ pub(crate) struct Tracer {
 enum TracerKind {
     Packets(PacketTracer),
     SingleRays(CpuTracer),
+    Fans(FanTracer),
 }
 
 impl Tracer {
     pub(crate) fn new(prepared: &Prepared, method: CpuMethod) -> Self {
         let kind = match method {
-            CpuMethod::Packets => TracerKind::Packets(PacketTracer::new(prepared)),
+            // `Auto` is resolved by the engine per call ([`CpuMethod::resolve`]).
+            CpuMethod::Packets | CpuMethod::Auto => {
+                TracerKind::Packets(PacketTracer::new(prepared))
+            }
             CpuMethod::SingleRays => TracerKind::SingleRays(CpuTracer::new(prepared)),
+            CpuMethod::Fans => {
+                TracerKind::Fans(FanTracer::new(prepared, BvhBuildParams::medium_build()))
+            }
         };
         Self {
             positions: prepared.positions.clone(),
@@ -491,6 +538,48 @@ fn bvh_columns(
     scatter_chunks(&order, ROWS_PER_CHUNK, chunks, columns, bits, words_per_row)
 }
 
+/// [`compute_columns`] with fans ([`CpuMethod::Fans`]): the columns' directions split once
+/// into fans ([`fan_groups`]), every vertex traces each fan from its origin with the lanes
+/// below its tangent plane masked off; rows in Morton order, [`ROWS_PER_CHUNK`] per task.
+fn fan_columns(
+    prepared: &Prepared,
+    tracer: &FanTracer,
+    directions: &[Vec3],
+    columns: Range<usize>,
+    offset: f32,
+    bits: &mut [u32],
+    words_per_row: usize,
+) -> u64 {
+    let dirs = &directions[columns.clone()];
+    let groups = fan_groups(dirs);
+    let fans: Vec<RayFan> = groups.iter().map(|g| RayFan::from_group(dirs, g)).collect();
+    let order = morton_order(prepared);
+    let chunks: Vec<(Vec<u32>, u64)> = order
+        .par_chunks(ROWS_PER_CHUNK)
+        .map(|rows| {
+            let mut out = vec![0u32; rows.len() * words_per_row];
+            let mut rays = 0u64;
+            for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
+                let Some((origin, normal)) = ray_origin(prepared, row as usize, offset) else {
+                    continue;
+                };
+                for (group, fan) in groups.iter().zip(&fans) {
+                    let mask = fan.facing(normal.into());
+                    rays += u64::from(mask.count_ones());
+                    let mut open = tracer.unoccluded(origin, fan, mask, f32::INFINITY);
+                    while open != 0 {
+                        let j = columns.start + group[open.trailing_zeros() as usize] as usize;
+                        open &= open - 1;
+                        out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
+                    }
+                }
+            }
+            (out, rays)
+        })
+        .collect();
+    scatter_chunks(&order, ROWS_PER_CHUNK, chunks, columns, bits, words_per_row)
+}
+
 /// Copies the columns `columns` of per-chunk row blocks (rows `order` in chunks of
 /// `chunk_rows`, as computed in Morton order) into the row-major `bits`; returns the rays
 /// the chunks cast.
@@ -516,12 +605,11 @@ fn scatter_chunks(
     rays
 }
 
-/// The scene's triangles as `obvhs` takes them (degenerate ones included: they never hit).
 /// A binary BVH (`obvhs`'s PLOC build with `quality`'s settings, at most `leaf_size` triangles
-/// per leaf) over the
-/// scene's triangles, with every box padded a little so that the slab test never drops a ray
-/// that the triangle test (with its [`EDGE_TOLERANCE`]) counts as a hit on the box's boundary;
-/// the triangles come back in leaf order. Empty for a scene without triangles.
+/// per leaf) over the scene's triangles, with every box padded a little so that the slab test
+/// never drops a ray that the triangle test (with its [`EDGE_TOLERANCE`]) counts as a hit on
+/// the box's boundary; the triangles come back in leaf order. Empty for a scene without
+/// triangles.
 pub(crate) fn padded_bvh2(
     prepared: &Prepared,
     quality: BvhBuildParams,
@@ -549,6 +637,7 @@ pub(crate) fn padded_bvh2(
     (nodes, ordered)
 }
 
+/// The scene's triangles as `obvhs` takes them (degenerate ones included: they never hit).
 fn scene_triangles(prepared: &Prepared) -> Vec<Triangle> {
     prepared
         .triangles

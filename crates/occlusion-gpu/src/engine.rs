@@ -343,7 +343,7 @@ impl VisibilityEngine {
         }
         match self.backend {
             Backend::Cpu => {
-                let method = self.params.cpu.method;
+                let method = self.params.cpu.method.resolve(k - first_new);
                 if !self
                     .cpu_tracer
                     .as_ref()

@@ -142,6 +142,28 @@ impl RayFan {
         out.used = self.used;
     }
 
+    /// The lanes in use whose direction d has d·`normal` > 0 (the n·l culling of shadow rays).
+    pub fn facing(&self, normal: Vec3) -> u64 {
+        let mut mask = 0u64;
+        for g in 0..GROUPS {
+            let dot = self.x[g] * normal.x + self.y[g] * normal.y + self.z[g] * normal.z;
+            mask |= u64::from(dot.cmpgt(Vec4::ZERO).bitmask()) << (4 * g);
+        }
+        mask & self.used
+    }
+
+    /// A fan of the directions `lanes` indexes (one entry of [`fan_groups`]'s result).
+    pub fn from_group(directions: &[Vec3], lanes: &[u32]) -> Self {
+        let mut fan = Self::new();
+        for quad in lanes.chunks(FAN_GROUP) {
+            for &i in quad.iter().filter(|&&i| i != u32::MAX) {
+                fan.push(directions[i as usize]);
+            }
+            fan.finish_group();
+        }
+        fan
+    }
+
     /// The direction of `lane`.
     pub fn direction(&self, lane: usize) -> Vec3 {
         let (g, i) = (lane / 4, lane % 4);
@@ -224,6 +246,58 @@ impl FanSetup {
     }
 }
 
+/// Directions split into fans: groups of at most [`FAN_GROUP`] close directions (one SIMD
+/// vector of the traversal), halved recursively at the median of the widest coordinate so
+/// each group is a compact cone, and [`FAN_SIZE`] / [`FAN_GROUP`] neighbouring groups per
+/// fan. Each fan is the list of its lanes' indices into `directions`, `u32::MAX` marking the
+/// unused lanes at the end of a short group; push them in order, calling
+/// [`RayFan::finish_group`] after every [`FAN_GROUP`] lanes. Deterministic.
+pub fn fan_groups(directions: &[Vec3]) -> Vec<Vec<u32>> {
+    fn split(directions: &[Vec3], mut pixels: Vec<u32>, out: &mut Vec<Vec<u32>>) {
+        if pixels.len() <= FAN_GROUP {
+            out.push(pixels);
+            return;
+        }
+        let (lo, hi) = pixels
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+                let d = directions[p as usize];
+                (lo.min(d), hi.max(d))
+            });
+        let axis = (hi - lo).max_position();
+        // Split into whole groups where possible, so no group is left nearly empty.
+        let groups = pixels.len().div_ceil(FAN_GROUP);
+        let cut = groups.div_ceil(2) * pixels.len() / groups;
+        // A partition at the cut, not a sort: O(n) per level (HC 1024² has 3 M pixels).
+        pixels.select_nth_unstable_by(cut, |&a, &b| {
+            directions[a as usize][axis].total_cmp(&directions[b as usize][axis])
+        });
+        let right = pixels.split_off(cut);
+        split(directions, pixels, out);
+        split(directions, right, out);
+    }
+    let mut groups = Vec::new();
+    split(
+        directions,
+        (0..directions.len() as u32).collect(),
+        &mut groups,
+    );
+    groups
+        .chunks(FAN_SIZE / FAN_GROUP)
+        .map(|fan| {
+            fan.iter()
+                .flat_map(|group| {
+                    let pad = FAN_GROUP - group.len();
+                    group
+                        .iter()
+                        .copied()
+                        .chain(std::iter::repeat_n(u32::MAX, pad))
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// Bit 4g set for every group g of four lanes with a lane in `mask`.
 #[inline(always)]
 fn live_groups(mask: u64) -> u64 {
@@ -242,8 +316,9 @@ pub(crate) struct FanTracer {
 }
 
 impl FanTracer {
-    pub(crate) fn new(prepared: &Prepared) -> Self {
-        let (nodes, tris) = padded_bvh2(prepared, BvhBuildParams::very_slow_build(), FAN_LEAF_SIZE);
+    /// `quality`: obvhs's build settings (a static scene affords the slowest, best tree).
+    pub(crate) fn new(prepared: &Prepared, quality: BvhBuildParams) -> Self {
+        let (nodes, tris) = padded_bvh2(prepared, quality, FAN_LEAF_SIZE);
         let triangles = tris
             .iter()
             .map(|t| FanTriangle([t.v0, t.v1, t.v2]))

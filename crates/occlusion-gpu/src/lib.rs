@@ -14,9 +14,10 @@
 //! Backends ([`Backend`]):
 //! * `Cpu` — exact ray casting, the accuracy reference: one shadow ray per (vertex,
 //!   direction) with n·l > 0 from the vertex pushed 1e-4 × the bounding-box diagonal along its
-//!   normal, multi-threaded with rayon. By default the rays of 64 neighbouring vertices towards
-//!   one direction walk an `obvhs` binary BVH together as a packet ([`CpuMethod`]); see
-//!   `benches/visibility.rs` for rays/s.
+//!   normal, multi-threaded with rayon. The rays of 64 neighbouring vertices towards one
+//!   direction walk an `obvhs` binary BVH together as a packet, or each vertex's directions
+//!   walk it as fans from its origin — fans from k = 258 up, where they are 1.2–1.6× faster
+//!   ([`CpuMethod`]); see `benches/visibility.rs` for rays/s.
 //! * `Depth` — the seed's future work (§8.1) on the GPU: orthographic Depth32Float maps per
 //!   direction in batches of 2D-array layers, then a compute pass depth-tests every vertex with
 //!   a slope-scaled bias (the counterpart of `glPolygonOffset(1, 1)`), writing visibility bits
@@ -93,10 +94,10 @@ mod rays;
 mod rigid;
 mod scene;
 
-pub use cpu::{CpuMethod, CpuParams, DEFAULT_OFFSET_RELATIVE};
+pub use cpu::{CpuMethod, CpuParams, DEFAULT_OFFSET_RELATIVE, FAN_MIN_COLUMNS};
 pub use engine::{Backend, VisibilityEngine, VisibilityParams};
 pub use error::OcclusionError;
-pub use fan::{FAN_GROUP, FAN_SIZE, RayFan};
+pub use fan::{FAN_GROUP, FAN_SIZE, RayFan, fan_groups};
 pub use filter::{
     Camera, DEFAULT_FILTER_THRESHOLD_FRACTION, FilterParams, FilterThreshold, FilteredVisibility,
     FrameStats, TriangleIdRenderer, TriangleSet, TriangleVisibility, VertexFilter, triangle_rows,

@@ -42,7 +42,9 @@ impl RayCaster {
     pub fn new(scene: &Scene) -> Result<Self, OcclusionError> {
         let prepared = Prepared::new(scene)?;
         let tracer = CpuTracer::new(&prepared);
-        let fans = FanTracer::new(&prepared);
+        // Built once per static scene: the slowest build gives the best tree (9 % fewer node
+        // visits than the medium one on the dress, 17 ms to build).
+        let fans = FanTracer::new(&prepared, obvhs::BvhBuildParams::very_slow_build());
         Ok(Self {
             prepared,
             tracer,

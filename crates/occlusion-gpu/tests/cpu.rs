@@ -17,7 +17,7 @@ fn engine() -> VisibilityEngine {
 /// where the ray passes within float noise of a triangle edge.
 #[test]
 fn matches_brute_force_on_sphere_over_plane() {
-    for method in [CpuMethod::Packets, CpuMethod::SingleRays] {
+    for method in [CpuMethod::Packets, CpuMethod::SingleRays, CpuMethod::Fans] {
         let params = VisibilityParams::default().with_cpu(CpuParams::default().with_method(method));
         matches_brute_force(VisibilityEngine::cpu(params), &format!("{method:?}"));
     }
@@ -238,10 +238,10 @@ fn bunny_res4_is_finite_and_bounded() {
     assert!((0.4..0.95).contains(&mean), "mean ambient {mean}");
 }
 
-/// The packet traversal (default) and the single-ray traversal of another BVH share only the
-/// triangle test: they must give the same M up to rays grazing an edge.
+/// The packet traversal, the single-ray traversal of another BVH and the fans (another
+/// triangle test): they must give the same M up to rays grazing an edge.
 #[test]
-fn packet_and_single_ray_traversals_agree() {
+fn packet_single_ray_and_fan_traversals_agree() {
     let mut scenes = vec![("sphere over plane", sphere_over_plane())];
     let sheet = grid(24, 2.0);
     let mut folded = Scene::new();
@@ -270,18 +270,20 @@ fn packet_and_single_ray_traversals_agree() {
                 .unwrap()
         };
         let packets = run(CpuMethod::Packets);
-        let single = run(CpuMethod::SingleRays);
-        let differing = (0..packets.rows())
-            .flat_map(|i| (0..sphere.len()).map(move |j| (i, j)))
-            .filter(|&(i, j)| packets.is_visible(i, j) != single.is_visible(i, j))
-            .count();
-        // Only rays through a shared edge or vertex within f32 rounding may go either way
-        // (seen: straight-down rays through the uv-sphere's pole vertex).
         let total = packets.rows() * sphere.len();
-        assert!(
-            differing * 10_000 <= total,
-            "{name}: {differing} of {total} entries differ"
-        );
+        for method in [CpuMethod::SingleRays, CpuMethod::Fans] {
+            let other = run(method);
+            let differing = (0..packets.rows())
+                .flat_map(|i| (0..sphere.len()).map(move |j| (i, j)))
+                .filter(|&(i, j)| packets.is_visible(i, j) != other.is_visible(i, j))
+                .count();
+            // Only rays through a shared edge or vertex within f32 rounding may go either way
+            // (seen: straight-down rays through the uv-sphere's pole vertex).
+            assert!(
+                differing * 10_000 <= total,
+                "{name}: {differing} of {total} entries differ between packets and {method:?}"
+            );
+        }
         assert!(packets.visible_count() > 0, "{name}: nothing visible");
     }
 }
