@@ -11,8 +11,10 @@
 //!   path: 8–11 % of the work on the dress, skipped);
 //! * a box that the interval bounds of the live lanes' reciprocal directions show no lane can
 //!   enter is skipped outright (without this test the traversal is 1.7× slower);
-//! * otherwise each live group is slab-tested and the child's mask narrows; the nearer child
-//!   along the fan's mean direction is visited first.
+//! * otherwise each live group is slab-tested and the child's mask narrows; the child whose
+//!   centre is nearer the origin is visited first (near occluders end lanes early: 1.1–1.5×
+//!   faster than ordering along the fan's mean direction, which the nearest point of the box
+//!   or the entry distance of the interval test also lose to).
 //!
 //! The triangle test uses the common origin o: with a = v₀ − o, b = v₁ − o, c = v₂ − o, the
 //! edge normals n₀ = b × c, n₁ = c × a, n₂ = a × b are computed once per triangle and a
@@ -172,7 +174,7 @@ impl RayFan {
 }
 
 /// A fan's reciprocal directions and the interval each axis spans over the live lanes
-/// (`None` where the lanes' signs differ: that axis does not bound the fan).
+/// (`bounded` false where the lanes' signs differ: that axis does not bound the fan).
 struct FanSetup {
     x: [Vec4; GROUPS],
     y: [Vec4; GROUPS],
@@ -180,8 +182,6 @@ struct FanSetup {
     bound_lo: Vec3A,
     bound_hi: Vec3A,
     bounded: BVec3A,
-    /// The live lanes' summed direction: children are visited nearest along it first.
-    mean: Vec3A,
 }
 
 impl FanSetup {
@@ -202,10 +202,8 @@ impl FanSetup {
             bound_lo: Vec3A::ZERO,
             bound_hi: Vec3A::ZERO,
             bounded: BVec3A::FALSE,
-            mean: Vec3A::ZERO,
         };
         let (mut low, mut high) = ([Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]);
-        let mut sum = [Vec4::ZERO; 3];
         let mut live = live_groups(mask);
         while live != 0 {
             let g = live.trailing_zeros() as usize / 4;
@@ -217,13 +215,9 @@ impl FanSetup {
                 nibble & 4 != 0,
                 nibble & 8 != 0,
             );
-            for (k, (inv, d)) in [(r.x[g], fan.x[g]), (r.y[g], fan.y[g]), (r.z[g], fan.z[g])]
-                .into_iter()
-                .enumerate()
-            {
+            for (k, inv) in [r.x[g], r.y[g], r.z[g]].into_iter().enumerate() {
                 low[k] = low[k].min(Vec4::select(on, inv, Vec4::INFINITY));
                 high[k] = high[k].max(Vec4::select(on, inv, Vec4::NEG_INFINITY));
-                sum[k] += Vec4::select(on, d, Vec4::ZERO);
             }
         }
         let mut bounded = [false; 3];
@@ -237,11 +231,6 @@ impl FanSetup {
             }
         }
         r.bounded = BVec3A::from_array(bounded);
-        r.mean = Vec3A::new(
-            sum[0].element_sum(),
-            sum[1].element_sum(),
-            sum[2].element_sum(),
-        );
         r
     }
 }
@@ -253,12 +242,12 @@ impl FanSetup {
 /// unused lanes at the end of a short group; push them in order, calling
 /// [`RayFan::finish_group`] after every [`FAN_GROUP`] lanes. Deterministic.
 pub fn fan_groups(directions: &[Vec3]) -> Vec<Vec<u32>> {
-    fn split(directions: &[Vec3], mut pixels: Vec<u32>, out: &mut Vec<Vec<u32>>) {
-        if pixels.len() <= FAN_GROUP {
-            out.push(pixels);
+    fn split(directions: &[Vec3], mut indices: Vec<u32>, out: &mut Vec<Vec<u32>>) {
+        if indices.len() <= FAN_GROUP {
+            out.push(indices);
             return;
         }
-        let (lo, hi) = pixels
+        let (lo, hi) = indices
             .iter()
             .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
                 let d = directions[p as usize];
@@ -266,14 +255,14 @@ pub fn fan_groups(directions: &[Vec3]) -> Vec<Vec<u32>> {
             });
         let axis = (hi - lo).max_position();
         // Split into whole groups where possible, so no group is left nearly empty.
-        let groups = pixels.len().div_ceil(FAN_GROUP);
-        let cut = groups.div_ceil(2) * pixels.len() / groups;
+        let groups = indices.len().div_ceil(FAN_GROUP);
+        let cut = groups.div_ceil(2) * indices.len() / groups;
         // A partition at the cut, not a sort: O(n) per level (HC 1024² has 3 M pixels).
-        pixels.select_nth_unstable_by(cut, |&a, &b| {
+        indices.select_nth_unstable_by(cut, |&a, &b| {
             directions[a as usize][axis].total_cmp(&directions[b as usize][axis])
         });
-        let right = pixels.split_off(cut);
-        split(directions, pixels, out);
+        let right = indices.split_off(cut);
+        split(directions, indices, out);
         split(directions, right, out);
     }
     let mut groups = Vec::new();
@@ -377,10 +366,11 @@ impl FanTracer {
             } else {
                 let first = node.first_index;
                 let (a, b) = (&self.nodes[first as usize], &self.nodes[first as usize + 1]);
-                let along =
+                // (Twice) the distance² from the origin to each child's centre: the nearer
+                // child is popped (and so tested) first.
+                let distance =
                     |n: &Bvh2Node| (n.aabb.min + n.aabb.max - 2.0 * origin).length_squared();
-                // The nearer child along the fan is popped (and so tested) first.
-                let order = if along(a) <= along(b) {
+                let order = if distance(a) <= distance(b) {
                     [(first + 1, b), (first, a)]
                 } else {
                     [(first, a), (first + 1, b)]
