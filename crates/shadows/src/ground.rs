@@ -1,0 +1,148 @@
+//! A receiver plane y = Y sampled on an N × N grid, and its exact shadow mask by rays through
+//! occlusion-gpu's BVH (the CPU twin of the stencil mask).
+
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+
+use crate::error::bad_parameter;
+use crate::{Light, ShadowError};
+
+/// Largest grid side: 8192² cells of f32 are 256 MiB.
+pub const MAX_GRID: usize = 8192;
+
+/// The receiver plane and its sampling: row j ↔ z_j = z0 + (j + ½)(z1 − z0)/N ascending,
+/// column i ↔ x_i = x0 + (i + ½)(x1 − x0)/N ascending.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GroundGrid {
+    /// Height of the plane.
+    pub y: f64,
+    /// (x0, z0, x1, z1).
+    pub extent: [f64; 4],
+    /// Cells per side.
+    pub n: usize,
+}
+
+impl GroundGrid {
+    /// A validated grid.
+    ///
+    /// # Errors
+    /// [`ShadowError::Parameter`] for a non-finite height or extent, x1 ≤ x0 or z1 ≤ z0, or a
+    /// side outside 1 ..= [`MAX_GRID`].
+    pub fn new(y: f64, extent: [f64; 4], n: usize) -> Result<Self, ShadowError> {
+        if !y.is_finite() {
+            return Err(bad_parameter(
+                "ground",
+                y,
+                "the plane's height must be finite",
+            ));
+        }
+        let [x0, z0, x1, z1] = extent;
+        if !(extent.iter().all(|v| v.is_finite()) && x1 > x0 && z1 > z0) {
+            return Err(bad_parameter(
+                "ground extent",
+                format!("{x0},{z0},{x1},{z1}"),
+                "needs finite X0,Z0,X1,Z1 with X1 > X0 and Z1 > Z0",
+            ));
+        }
+        if !(1..=MAX_GRID).contains(&n) {
+            return Err(bad_parameter(
+                "grid",
+                n,
+                "cells per side must be in 1 ..= 8192",
+            ));
+        }
+        Ok(Self { y, extent, n })
+    }
+
+    /// The default extent: the mesh's x/z bounding box scaled ×3 about its centre (a square
+    /// grid needs no square extent; cells follow the extent's aspect).
+    ///
+    /// # Errors
+    /// As [`GroundGrid::new`]; an empty or flat (zero x or z extent) mesh gets a unit margin.
+    pub fn around(positions: &[Vec3], y: f64, n: usize) -> Result<Self, ShadowError> {
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for p in positions {
+            lo = lo.min(p.as_dvec3());
+            hi = hi.max(p.as_dvec3());
+        }
+        if positions.is_empty() {
+            (lo, hi) = (DVec3::ZERO, DVec3::ZERO);
+        }
+        let centre = (lo + hi) / 2.0;
+        let half = ((hi - lo) * 1.5).max(DVec3::splat(0.5));
+        Self::new(
+            y,
+            [
+                centre.x - half.x,
+                centre.z - half.z,
+                centre.x + half.x,
+                centre.z + half.z,
+            ],
+            n,
+        )
+    }
+
+    /// World position of cell (i = column, j = row).
+    pub fn cell_centre(&self, i: usize, j: usize) -> DVec3 {
+        let [x0, z0, x1, z1] = self.extent;
+        let f = |k: usize, a: f64, b: f64| a + (k as f64 + 0.5) * (b - a) / self.n as f64;
+        DVec3::new(f(i, x0, x1), self.y, f(j, z0, z1))
+    }
+
+    /// Centre of the extent on the plane.
+    pub fn centre(&self) -> DVec3 {
+        let [x0, z0, x1, z1] = self.extent;
+        DVec3::new((x0 + x1) / 2.0, self.y, (z0 + z1) / 2.0)
+    }
+}
+
+/// The exact mask of `grid` (row-major, N × N, 1 = the cell centre's segment to the light
+/// meets a caster triangle, 0 = lit), by one ray per cell through occlusion-gpu's BVH.
+///
+/// Rays start a hair towards the light (occlusion-gpu's relative offset times the caster's
+/// diagonal), so a caster face lying in the ground plane does not shadow the plane — the rule
+/// the stencil path follows by pushing volumes back.
+///
+/// # Errors
+/// [`ShadowError::Rays`] for a caster the BVH cannot take (no triangles, non-finite values);
+/// [`ShadowError::Light`] for an invalid light.
+pub fn exact_ground_mask(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    light: &Light,
+    grid: &GroundGrid,
+) -> Result<Vec<f32>, ShadowError> {
+    let light = light.validated()?;
+    let scene = occlusion_gpu::Scene::single(
+        positions.to_vec(),
+        vec![Vec3::Y; positions.len()],
+        triangles.to_vec(),
+    )?;
+    let caster = occlusion_gpu::RayCaster::new(&scene)?;
+    let offset = f64::from(occlusion_gpu::DEFAULT_OFFSET_RELATIVE * caster.diagonal());
+    let n = grid.n;
+    let mut mask = vec![0.0f32; n * n];
+    mask.par_chunks_mut(n).enumerate().for_each(|(j, row)| {
+        let mut cache = Default::default();
+        for (i, cell) in row.iter_mut().enumerate() {
+            let p = grid.cell_centre(i, j);
+            let towards = light.towards(p);
+            let origin = p + towards * offset;
+            let blocked = match light {
+                Light::Point(l) => {
+                    let d = l - origin;
+                    d.dot(towards) > 0.0
+                        && caster.occluded(caster.centred(origin), d.as_vec3(), 1.0, &mut cache)
+                }
+                Light::Directional(d) => caster.occluded(
+                    caster.centred(origin),
+                    d.as_vec3(),
+                    f32::INFINITY,
+                    &mut cache,
+                ),
+            };
+            *cell = f32::from(u8::from(blocked));
+        }
+    });
+    Ok(mask)
+}
