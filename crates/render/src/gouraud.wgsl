@@ -10,8 +10,10 @@ struct MeshIn {
 // Centroid sampling: under MSAA a fragment of a partly covered pixel is shaded inside its
 // triangle, not at the pixel centre, where interpolation would extrapolate (and a steep
 // radiance gradient at a silhouette goes negative).
+// Invariant position: passes that draw the same surface again with depth `Equal` (a light
+// term added where the shadow stencil is 0) land on exactly this depth.
 struct MeshOut {
-    @builtin(position) clip: vec4<f32>,
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) @interpolate(perspective, centroid) front: vec3<f32>,
     @location(1) @interpolate(perspective, centroid) back: vec3<f32>,
 };

@@ -164,3 +164,36 @@ impl BoundaryTexture {
         self.texels[i]
     }
 }
+
+/// Where the interpolated coordinate crosses `level` on the mesh's edges: for each edge whose
+/// end points lie on opposite sides, the point at t* = (u₁ − level)/(u₁ − u₂) from the first
+/// (SEED-NOTES §3.3). These points trace the smooth boundary (the u = ½ iso-line for the
+/// step texture), against which the terminator's analytic position is measured.
+pub fn contour_points(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    u: &[f32],
+    level: f32,
+) -> Vec<DVec3> {
+    let mut edges: Vec<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+        .into_iter()
+        .filter_map(|(a, b)| {
+            let (ua, ub) = (f64::from(u[a as usize]), f64::from(u[b as usize]));
+            let level = f64::from(level);
+            ((ua - level) * (ub - level) < 0.0).then(|| {
+                let t = (ua - level) / (ua - ub);
+                let (pa, pb) = (
+                    positions[a as usize].as_dvec3(),
+                    positions[b as usize].as_dvec3(),
+                );
+                pa + (pb - pa) * t
+            })
+        })
+        .collect()
+}

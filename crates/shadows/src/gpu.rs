@@ -15,22 +15,42 @@ pub const SHADOWS_SHADER: &str = include_str!("shadows.wgsl");
 
 const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
 
-/// Depth-stencil state of a volume draw under z-fail: depth tested, never written; a fragment
-/// behind the stored depth increments the stencil on back faces and decrements it on front
-/// faces (wrapping), so a point ends at the number of volumes containing it. Volumes are
-/// pushed back by a constant bias of a few units of depth precision: a cap lying on the
-/// surface it came from, or a caster face coplanar with a receiver, then counts as behind it,
-/// and that surface is lit. (A slope-scaled bias would push the steep side quads of a slanted
-/// volume behind receivers they pass in front of.)
-pub fn z_fail_state(
+/// How the stencil counts volume faces along a pixel's ray.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Counting {
+    /// Carmack's reverse (Bilodeau & Songy 1999): count the faces *behind* the surface —
+    /// back faces +1, front faces −1 on depth fail. Right wherever the eye is, as long as the
+    /// volumes are closed and nothing clips their far side (caps at infinity in a
+    /// reversed-infinite frame).
+    #[default]
+    ZFail,
+    /// Heidmann 1991: count the faces *in front of* the surface — front faces +1, back faces
+    /// −1 on depth pass. Needs no back caps but is wrong when the eye is inside a volume or the
+    /// near plane cuts one (thesis T 3231–3236); kept to show exactly that.
+    ZPass,
+}
+
+/// Depth-stencil state of a volume draw: depth tested, never written; the stencil counts
+/// faces by `counting` (wrapping), so a surface point ends at the number of volumes containing
+/// it. Volumes are pushed back by a constant bias of a few units of depth precision: a cap
+/// lying on the surface it came from, or a caster face coplanar with a receiver, then counts as
+/// behind it, and that surface is lit. (A slope-scaled bias would push the steep side quads of
+/// a slanted volume behind receivers they pass in front of.)
+pub fn volume_stencil_state(
     format: wgpu::TextureFormat,
     compare: wgpu::CompareFunction,
+    counting: Counting,
 ) -> wgpu::DepthStencilState {
-    let face = |depth_fail_op| wgpu::StencilFaceState {
+    use wgpu::StencilOperation::{DecrementWrap, IncrementWrap, Keep};
+    let face = |on_pass, on_fail| wgpu::StencilFaceState {
         compare: wgpu::CompareFunction::Always,
-        fail_op: wgpu::StencilOperation::Keep,
-        depth_fail_op,
-        pass_op: wgpu::StencilOperation::Keep,
+        fail_op: Keep,
+        depth_fail_op: on_fail,
+        pass_op: on_pass,
+    };
+    let (front, back) = match counting {
+        Counting::ZFail => (face(Keep, DecrementWrap), face(Keep, IncrementWrap)),
+        Counting::ZPass => (face(IncrementWrap, Keep), face(DecrementWrap, Keep)),
     };
     let away = if compare == wgpu::CompareFunction::Greater {
         -1
@@ -42,8 +62,8 @@ pub fn z_fail_state(
         depth_write_enabled: Some(false),
         depth_compare: Some(compare),
         stencil: wgpu::StencilState {
-            front: face(wgpu::StencilOperation::DecrementWrap),
-            back: face(wgpu::StencilOperation::IncrementWrap),
+            front,
+            back,
             read_mask: 0xff,
             write_mask: 0xff,
         },
@@ -168,7 +188,7 @@ impl MaskRenderer {
                 attributes: &wgpu::vertex_attr_array![0 => Float32x4],
             }],
             wgpu::ColorWrites::empty(),
-            z_fail_state(depth_format, less),
+            volume_stencil_state(depth_format, less, Counting::ZFail),
         )
         .build(device);
         let mark = desc(

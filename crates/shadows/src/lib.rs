@@ -15,7 +15,9 @@
 //! * [`ground`]: a receiver plane sampled on a grid and its exact mask by rays through
 //!   occlusion-gpu's BVH — the twin every stencil result is checked against.
 //! * `gpu` (feature `gpu`, default): the z-fail stencil pipeline and the ground mask seen by an
-//!   orthographic camera from above ([`stencil_ground_mask`]).
+//!   orthographic camera from above ([`stencil_ground_mask`]); `frame`: the effect in the
+//!   render crate's shared frame — per light, stencil reset, volumes, and the light's direct
+//!   term added where the count is 0, through eq. 5.6's texture (`StencilShadows`).
 //!
 //! # Example
 //! ```
@@ -50,6 +52,8 @@
 pub mod boundary;
 mod error;
 #[cfg(feature = "gpu")]
+pub mod frame;
+#[cfg(feature = "gpu")]
 mod gpu;
 pub mod ground;
 mod light;
@@ -60,8 +64,8 @@ pub use boundary::{BoundaryMode, BoundaryTexture, DEFAULT_ALPHA_DEG, boundary_u}
 pub use error::ShadowError;
 #[cfg(feature = "gpu")]
 pub use gpu::{
-    MaskRenderer, SHADOWS_SHADER, ground_extrusion, stencil_ground_mask, stencil_test_state,
-    z_fail_state,
+    Counting, MaskRenderer, SHADOWS_SHADER, ground_extrusion, stencil_ground_mask,
+    stencil_test_state, volume_stencil_state,
 };
 pub use ground::{GroundGrid, exact_ground_mask};
 pub use light::Light;

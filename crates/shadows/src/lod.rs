@@ -265,7 +265,10 @@ fn sample_surface(p: &[DVec3], tris: &[[u32; 3]], count: usize, seed: u64) -> Ve
             out.push(a + (b - a) * u + (c - a) * v);
         }
     }
-    out.extend(tris.iter().flatten().map(|&i| p[i as usize]));
+    let mut used: Vec<u32> = tris.iter().flatten().copied().collect();
+    used.sort_unstable();
+    used.dedup();
+    out.extend(used.iter().map(|&i| p[i as usize]));
     out
 }
 
@@ -292,11 +295,19 @@ impl TriangleGrid {
             (lo, hi) = (DVec3::ZERO, DVec3::ZERO);
         }
         let size = (hi - lo).max(DVec3::splat(1e-12));
-        // About two triangles per cell on a surface: cells ∝ N^(1/2) per axis of the surface.
-        let target_cells = (tris.len().max(1) as f64 * 2.0).min(4e6);
-        let cell = (size.x * size.y * size.z / target_cells)
-            .cbrt()
-            .max(size.max_element() / 256.0);
+        // Cells about the size of an average triangle (a surface then puts O(1) triangles in
+        // each cell it crosses), at most 4 M cells.
+        let area: f64 = tris
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| p[i as usize]);
+                (b - a).cross(c - a).length() / 2.0
+            })
+            .sum();
+        let cell = (area / tris.len().max(1) as f64)
+            .sqrt()
+            .max((size.x * size.y * size.z / 4e6).cbrt())
+            .max(size.max_element() / 1024.0);
         let dims = (size / cell)
             .ceil()
             .as_uvec3()

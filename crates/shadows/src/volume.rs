@@ -344,6 +344,15 @@ impl ShadowVolume {
         &self.vertices
     }
 
+    /// Append the triangles of `other`, built for the same light, origin and extrusion:
+    /// several casters drawn as one volume (the counts add, lit ⇔ 0 still holds).
+    pub fn append(&mut self, other: &ShadowVolume) {
+        self.vertices.extend_from_slice(&other.vertices);
+        self.stats.casting_faces += other.stats.casting_faces;
+        self.stats.silhouette_edges += other.stats.silhouette_edges;
+        self.stats.quads += other.stats.quads;
+    }
+
     /// What the last build produced.
     pub fn stats(&self) -> VolumeStats {
         self.stats

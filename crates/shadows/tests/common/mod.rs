@@ -108,3 +108,6 @@ pub fn stencil_mask(
         shadows::stencil_ground_mask(&gpu, positions, triangles, light, sides, grid).unwrap();
     Some(mask)
 }
+
+#[cfg(feature = "gpu")]
+pub mod frame;
