@@ -418,6 +418,7 @@ pub fn stencil_ground_mask(
         sides,
         extrusion: Extrusion::Finite(ground_extrusion(positions, grid, light)),
         origin: grid.centre(),
+        ..Default::default()
     };
     let stats = volume.build(&topology, positions, light, &params)?;
     let mask = MaskRenderer::new(&gpu.device).render(gpu, &volume, grid)?;

@@ -15,9 +15,12 @@
 //! thesis's metric (T 5850–5853).
 //!
 //! **Self-shadowing from a coarse caster** (the case the experiment never had): the coarse
-//! surface passes up to its one-sided Hausdorff distance h in front of the display surface, so
-//! a receiver point tests its path to the light from a point lifted by h along its normal (and
-//! towards the light); [`LodLevel::receiver_offset`] is that h.
+//! surface stands up to its backward Hausdorff distance h out of the display surface, and
+//! where it passes above the lit display surface it shadows it (acne: 2,166 pixels on the
+//! height field of the hard-case test). The rule: each caster vertex moves by h along its
+//! normal, away from the light's side ([`crate::volume::VolumeParams::offset`]), before its
+//! volume is built; [`LodLevel::receiver_offset`] is that h. Moving along the light instead is
+//! not enough on slopes, where the gap along the light is h / cos(n, l).
 
 use glam::{DVec3, Vec3};
 use rand::{Rng, SeedableRng};
@@ -29,6 +32,10 @@ use crate::error::bad_parameter;
 
 /// Default Hausdorff samples per direction (plus every vertex).
 pub const DEFAULT_SAMPLES: usize = 20_000;
+/// Lattice divisions per triangle edge on the simplified surface (45 points per triangle).
+const LATTICE: usize = 8;
+/// Largest simplified mesh that gets the lattice.
+const MAX_LATTICE_TRIANGLES: usize = 50_000;
 
 /// Which level a caster uses.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -202,9 +209,13 @@ pub fn caster_lod(
 }
 
 /// The sampled symmetric Hausdorff distance between the surface of `triangles` and of
-/// `simplified` (both indexing `positions`): `samples` area-weighted points on each plus its
-/// vertices, each point's exact distance to the other surface (closest point on triangle, a
-/// uniform grid to find candidates), f64 throughout.
+/// `simplified` (both indexing `positions`): `samples` area-weighted random points on each plus
+/// its vertices, and on `simplified` (up to 50,000 triangles) a barycentric lattice of 45
+/// points per triangle — the farthest point of a large coarse face from the fine surface lies
+/// inside it, where random points are thin (on a 720-triangle sheet, 20,000 random points
+/// alone found 0.0117 where the lattice finds 0.0139); each point's exact distance to the
+/// other surface (closest point on triangle, a uniform grid to find candidates), f64
+/// throughout.
 pub fn hausdorff(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
@@ -225,16 +236,28 @@ pub fn hausdorff(
     } else {
         0.0
     };
-    let one_way = |from: &[[u32; 3]], to: &[[u32; 3]], seed: u64| {
+    let one_way = |from: &[[u32; 3]], to: &[[u32; 3]], seed: u64, lattice: bool| {
         let grid = TriangleGrid::new(&p, to);
-        sample_surface(&p, from, samples, seed)
+        let mut points = sample_surface(&p, from, samples, seed);
+        if lattice && from.len() <= MAX_LATTICE_TRIANGLES {
+            points.extend(from.iter().flat_map(|t| {
+                let [a, b, c] = t.map(|i| p[i as usize]);
+                (0..=LATTICE).flat_map(move |i| {
+                    (0..=LATTICE - i).map(move |j| {
+                        let (u, v) = (i as f64 / LATTICE as f64, j as f64 / LATTICE as f64);
+                        a + (b - a) * u + (c - a) * v
+                    })
+                })
+            }));
+        }
+        points
             .par_iter()
             .map(|q| grid.distance(&p, to, *q))
             .reduce(|| 0.0, f64::max)
     };
     Hausdorff {
-        forward: one_way(triangles, simplified, seed),
-        backward: one_way(simplified, triangles, seed ^ 0x9e37_79b9_7f4a_7c15),
+        forward: one_way(triangles, simplified, seed, false),
+        backward: one_way(simplified, triangles, seed ^ 0x9e37_79b9_7f4a_7c15, true),
         diagonal,
         samples,
     }

@@ -68,6 +68,14 @@ pub struct VolumeParams {
     pub extrusion: Extrusion,
     /// Subtracted (in f64) from every output vertex: the camera-relative origin.
     pub origin: DVec3,
+    /// Each caster vertex moves this far along its normal before extrusion (≥ 0): inwards for
+    /// [`Sides::One`], away from the light's side for [`Sides::Two`]. The offset rule that keeps
+    /// a coarse caster from shadowing the fine surface it approximates: its backward Hausdorff
+    /// distance ([`crate::LodLevel::receiver_offset`]), the farthest the coarse surface stands
+    /// out of the fine one. Moving along the light instead would not do: on a slope the gap
+    /// measured along the light is the Hausdorff distance divided by cos(n, l). 0 for a full
+    /// caster.
+    pub offset: f64,
 }
 
 impl Default for VolumeParams {
@@ -76,6 +84,7 @@ impl Default for VolumeParams {
             sides: Sides::One,
             extrusion: Extrusion::Infinite,
             origin: DVec3::ZERO,
+            offset: 0.0,
         }
     }
 }
@@ -197,6 +206,8 @@ impl VolumeStats {
 #[derive(Clone, Debug, Default)]
 pub struct ShadowVolume {
     orientation: Vec<i8>,
+    moved: Vec<DVec3>,
+    normals: Vec<DVec3>,
     near: Vec<[f32; 4]>,
     far: Vec<[f32; 4]>,
     vertices: Vec<[f32; 4]>,
@@ -233,6 +244,13 @@ impl ShadowVolume {
         if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
             return Err(ShadowError::Mesh(format!("vertex {i} = {p} is not finite")));
         }
+        if !(params.offset >= 0.0 && params.offset.is_finite()) {
+            return Err(crate::error::bad_parameter(
+                "caster offset",
+                params.offset,
+                "must be finite and ≥ 0",
+            ));
+        }
         if let Extrusion::Finite(d) = params.extrusion
             && !(d > 0.0 && d.is_finite())
         {
@@ -243,7 +261,8 @@ impl ShadowVolume {
             ));
         }
         self.orient_faces(topology, positions, &light, params.sides);
-        self.extrude_vertices(positions, &light, params);
+        self.offset_vertices(topology, positions, &light, params);
+        self.extrude_vertices(&light, params);
         self.assemble(topology);
         Ok(self.stats)
     }
@@ -279,11 +298,43 @@ impl ShadowVolume {
         }
     }
 
-    fn extrude_vertices(&mut self, positions: &[Vec3], light: &Light, params: &VolumeParams) {
+    /// The caster's vertices in f64, moved by the offset rule (see [`VolumeParams::offset`]).
+    fn offset_vertices(
+        &mut self,
+        topology: &CasterTopology,
+        positions: &[Vec3],
+        light: &Light,
+        params: &VolumeParams,
+    ) {
+        self.moved.clear();
+        self.moved.extend(positions.iter().map(|p| p.as_dvec3()));
+        if params.offset == 0.0 {
+            return;
+        }
+        self.normals.clear();
+        self.normals.resize(positions.len(), DVec3::ZERO);
+        for t in &topology.triangles {
+            let [a, b, c] = t.map(|i| self.moved[i as usize]);
+            let n = (b - a).cross(c - a);
+            for &i in t {
+                self.normals[i as usize] += n;
+            }
+        }
+        for (v, n) in self.moved.iter_mut().zip(&self.normals) {
+            let n = n.normalize_or_zero();
+            let side = match params.sides {
+                Sides::One => 1.0,
+                Sides::Two if n.dot(light.towards(*v)) < 0.0 => -1.0,
+                Sides::Two => 1.0,
+            };
+            *v -= n * (side * params.offset);
+        }
+    }
+
+    fn extrude_vertices(&mut self, light: &Light, params: &VolumeParams) {
         self.near.clear();
         self.far.clear();
-        for p in positions {
-            let v = p.as_dvec3();
+        for &v in &self.moved {
             let rel = v - params.origin;
             self.near
                 .push([rel.x as f32, rel.y as f32, rel.z as f32, 1.0]);

@@ -48,6 +48,7 @@ fn build(
         sides,
         extrusion: Extrusion::Finite(d),
         origin: DVec3::ZERO,
+        ..Default::default()
     };
     volume.build(&topology, positions, light, &params).unwrap();
     volume
@@ -175,6 +176,7 @@ fn infinite_extrusion_puts_far_vertices_at_w_zero_along_the_light() {
         sides: Sides::One,
         extrusion: Extrusion::Infinite,
         origin: DVec3::ZERO,
+        ..Default::default()
     };
     volume
         .build(&topology, &positions, &Light::Point(l), &params)
@@ -207,6 +209,7 @@ fn rebuilding_a_deforming_caster_allocates_nothing() {
         sides: Sides::Two,
         extrusion: Extrusion::Infinite,
         origin: DVec3::ZERO,
+        ..Default::default()
     };
     let mut volume = ShadowVolume::new();
     // Worst case first: every face casts when the sheet is flat.

@@ -110,6 +110,7 @@ pub fn render(
                 sides: Sides::One,
                 extrusion: Extrusion::Infinite,
                 origin: DVec3::ZERO,
+                ..Default::default()
             };
             v.build(&topology, &s.caster.0, light, &params).unwrap();
             v

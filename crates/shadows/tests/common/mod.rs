@@ -62,6 +62,7 @@ pub fn winding_mask(
         sides,
         extrusion: Extrusion::Finite(extrusion(positions, grid, light)),
         origin: grid.centre(),
+        ..Default::default()
     };
     volume.build(&topology, positions, light, &params).unwrap();
     let mut mask = Vec::with_capacity(grid.n * grid.n);
