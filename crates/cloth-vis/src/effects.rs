@@ -53,7 +53,11 @@ impl Effect {
     pub fn is_built(self) -> bool {
         matches!(
             self,
-            Effect::Lighting | Effect::SelfShadowing | Effect::StaticShadowing | Effect::Btf
+            Effect::Lighting
+                | Effect::SelfShadowing
+                | Effect::StaticShadowing
+                | Effect::Btf
+                | Effect::ShadowVolumes
         )
     }
 

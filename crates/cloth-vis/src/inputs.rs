@@ -243,13 +243,29 @@ fn load_file(path: &Path, scene: &Scene, index: usize) -> Result<Geometry, Error
 pub fn load_environment(
     scene: &Scene,
 ) -> Result<(lightsphere::Environment, serde_json::Value), Error> {
+    load_environment_with(scene, true)
+}
+
+/// [`load_environment`], with the procedural sky's sun left out when `sun` is false (a
+/// `shadow-volumes` light then carries the sun's direct light, so the sky must not light with
+/// it twice).
+///
+/// # Errors
+/// As [`load_environment`].
+pub fn load_environment_with(
+    scene: &Scene,
+    sun: bool,
+) -> Result<(lightsphere::Environment, serde_json::Value), Error> {
     let desc = scene.environment.as_ref().ok_or_else(|| Error::Scene {
         origin: scene.origin.clone(),
         message: "environment stage planned without [environment]".to_owned(),
     })?;
     let (env, source) = match scene.environment_source()? {
         Some(EnvironmentSource::SynthSky) => {
-            let params = sky_params(scene);
+            let mut params = sky_params(scene);
+            if !sun {
+                params.sun_to_sky_ratio = 0.0;
+            }
             let image = synth::sky(&params)?;
             let env =
                 lightsphere::Environment::from_latlong(image.width, image.height, image.texels)?;

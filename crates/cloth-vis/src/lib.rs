@@ -51,6 +51,7 @@ pub mod plan;
 pub mod report;
 pub mod run;
 pub mod scene;
+pub mod shadow_volumes;
 pub mod shadowing;
 pub mod static_shadowing;
 

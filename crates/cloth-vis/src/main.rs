@@ -37,6 +37,9 @@ enum Command {
     /// Static self-shadowing from per-vertex visibility maps: hemicube, single plane or
     /// hemisphere, under an environment and point lights (thesis §4.3).
     Hemicube(commands::hemicube::HemicubeArgs),
+    /// The shadow a mesh casts on a ground plane as an [N, N] mask: z-fail shadow volumes
+    /// (or exact rays), optional LOD casters (thesis §2.4.1, §4.2, §5.5.1).
+    Shadows(commands::shadows::ShadowsArgs),
     /// Load a mesh or an animation and print what the loader found (counts, quirks, time).
     Inspect(commands::inspect::InspectArgs),
 }
@@ -55,6 +58,7 @@ fn main() -> ExitCode {
         Command::Btf { command } => command.run(),
         Command::Visibility(args) => args.run(),
         Command::Hemicube(args) => args.run(),
+        Command::Shadows(args) => args.run(),
         Command::Inspect(args) => args.run(),
     };
     match result {

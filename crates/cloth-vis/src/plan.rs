@@ -9,6 +9,7 @@
 //! | `static-visibility` | `static-shadowing` (per-vertex visibility maps and their radiance, hemicube) |
 //! | `lighting` | `lighting` or `self-shadowing` (per-vertex radiance, with M when computed) |
 //! | `render` | always (PNG/EXR) |
+//! | `shadow-volumes` | `shadow-volumes` (per frame: caster volumes per light, stencil-masked direct light in the frame) |
 //! | `btf` | `btf` (a compressed BTF on the objects with UVs, beside plain texturing; its own PNG) |
 //!
 //! Later effects (self-shadowing, BTF, shadow volumes, translucency) add their own stages here
@@ -35,6 +36,8 @@ pub enum Stage {
     StaticVisibility,
     /// Per-vertex image-based radiance.
     Lighting,
+    /// Shadow volumes of the casters for every light, drawn into the frame's stencil.
+    ShadowVolumes,
     /// Rasterise and write images.
     Render,
     /// The BTF material on the chosen objects, beside plain texture mapping (own image).
@@ -51,6 +54,7 @@ impl Stage {
             Stage::Visibility => "visibility",
             Stage::StaticVisibility => "static-visibility",
             Stage::Lighting => "lighting",
+            Stage::ShadowVolumes => "shadow-volumes",
             Stage::Render => "render",
             Stage::Btf => "btf",
         }
@@ -68,8 +72,9 @@ impl Stage {
             ],
             Effect::StaticShadowing => &[Stage::Environment, Stage::StaticVisibility],
             Effect::Btf => &[Stage::Btf],
-            // Not built yet: validation rejects them before planning.
-            Effect::ShadowVolumes | Effect::Translucency => &[],
+            Effect::ShadowVolumes => &[Stage::ShadowVolumes],
+            // Not built yet: validation rejects it before planning.
+            Effect::Translucency => &[],
         }
     }
 }

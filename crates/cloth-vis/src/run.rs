@@ -10,7 +10,9 @@ use gpu_context::{GpuContext, GpuOptions, HdrImage};
 use indicatif::{ProgressBar, ProgressStyle};
 use render::sequence::{FrameRange, frame_file_name};
 use render::tone::{Display, ToneCurve};
-use render::{Background, Camera, DrawMesh, FrameFormat, Renderer, bounding_sphere, output};
+use render::{
+    Background, Camera, DrawMesh, FrameFormat, FramePass, Renderer, bounding_sphere, output,
+};
 use serde_json::json;
 
 use crate::Error;
@@ -19,6 +21,7 @@ use crate::object::WorldObject;
 use crate::plan::{Plan, Stage};
 use crate::report::{RunReport, StageRecord};
 use crate::scene::{BackgroundDesc, BackgroundKeyword, ExposureDesc, GROUND_NAME, Scene, ToneDesc};
+use crate::shadow_volumes::ShadowVolumeStage;
 use crate::shadowing::VisibilityStage;
 use crate::static_shadowing::StaticShadowingStage;
 
@@ -152,17 +155,41 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
     } else {
         None
     };
+    // A shadow-volume light that is the sky's sun carries its direct light: the sky that
+    // lights the vertices is made without it.
+    let volumes_planned = plan.contains(Stage::ShadowVolumes);
+    let sunless = if volumes_planned && scene.shadow_volumes.takes_sun() {
+        Some(crate::inputs::load_environment_with(scene, false)?.0)
+    } else {
+        None
+    };
     let lights = if plan.contains(Stage::LightDirections) {
-        let env = environment.as_ref().ok_or_else(|| Error::Scene {
-            origin: scene.origin.clone(),
-            message: "lighting planned without an environment".to_owned(),
-        })?;
+        let env = sunless
+            .as_ref()
+            .or(environment.as_ref())
+            .ok_or_else(|| Error::Scene {
+                origin: scene.origin.clone(),
+                message: "lighting planned without an environment".to_owned(),
+            })?;
         Some(timer.run(Stage::LightDirections, || light_directions(scene, env))?)
     } else {
         None
     };
 
-    let (mut renderer, background, format) = renderer_for(scene, &gpu, environment.as_ref());
+    // Volumes reach infinity: their frame has no far plane.
+    let depth = if volumes_planned {
+        render::DepthConvention::ReversedInfinite
+    } else {
+        render::DepthConvention::Standard
+    };
+    let (mut renderer, background, format) = renderer_for(scene, &gpu, environment.as_ref(), depth);
+    let mut volumes = if volumes_planned {
+        Some(timer.run(Stage::ShadowVolumes, || {
+            ShadowVolumeStage::new(scene, &gpu, &renderer, &objects)
+        })?)
+    } else {
+        None
+    };
     // One engine for the whole run: GPU backends keep their pipelines across frames.
     let mut shadowing = if plan.contains(Stage::Visibility) {
         Some(VisibilityStage::new(scene, Some(&gpu))?)
@@ -198,9 +225,16 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                         Ok(((), stage.light(Some(&gpu), &mut objects, env)?))
                     })?;
                 }
+                if let Some(stage) = volumes.as_mut() {
+                    timer.run(Stage::ShadowVolumes, || {
+                        Ok(((), stage.prepare(scene, &gpu, &mut objects)?))
+                    })?;
+                }
+                let passes: Vec<&dyn FramePass> =
+                    volumes.iter().map(|v| v.pass() as &dyn FramePass).collect();
                 timer.run(Stage::Render, || {
                     let (image, params, written) =
-                        render_still(scene, tmp, &gpu, &mut renderer, &objects, &look)?;
+                        render_still(scene, tmp, &gpu, &mut renderer, &objects, &look, &passes)?;
                     outputs = written;
                     Ok((image, params))
                 })?
@@ -212,6 +246,7 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                     &gpu,
                     shadowing.as_mut(),
                     statics.as_ref().map(|(stage, env)| (stage, *env)),
+                    volumes.as_mut(),
                     &mut renderer,
                     &mut objects,
                     lights.as_ref(),
@@ -425,8 +460,9 @@ fn renderer_for(
     scene: &Scene,
     gpu: &GpuContext,
     environment: Option<&lightsphere::Environment>,
+    depth: render::DepthConvention,
 ) -> (Renderer, Background, FrameFormat) {
-    let format = FrameFormat::for_context(gpu);
+    let format = FrameFormat::for_context(gpu).with_depth(depth);
     let mut renderer = Renderer::new(&gpu.device, format);
     let background = background(scene, environment.is_some());
     if background == Background::Environment {
@@ -457,7 +493,8 @@ pub fn render_still_image(
     objects: &[WorldObject],
     environment: Option<&lightsphere::Environment>,
 ) -> Result<(HdrImage, Display, Background), Error> {
-    let (mut renderer, background, _) = renderer_for(scene, gpu, environment);
+    let (mut renderer, background, _) =
+        renderer_for(scene, gpu, environment, render::DepthConvention::Standard);
     let (camera, centre, radius) = frame_camera(scene, objects, None);
     crate::image_checks::check_in_view(scene, &camera, centre, radius)?;
     set_gouraud_meshes(gpu, &mut renderer, objects, &camera, &[])?;
@@ -575,9 +612,16 @@ fn render_still(
     renderer: &mut Renderer,
     objects: &[WorldObject],
     look: &Look,
+    passes: &[&dyn FramePass],
 ) -> Result<(HdrImage, serde_json::Value, Vec<PathBuf>), Error> {
     set_gouraud_meshes(gpu, renderer, objects, &look.camera, &[])?;
-    let image = renderer.render(&gpu.device, &gpu.queue, &look.camera, look.background, &[])?;
+    let image = renderer.render(
+        &gpu.device,
+        &gpu.queue,
+        &look.camera,
+        look.background,
+        passes,
+    )?;
     crate::image_checks::check_rendered(scene, &image, None)?;
     let display = display_for(scene, &image);
     let written = write_images(
@@ -610,6 +654,7 @@ fn render_sequence(
     gpu: &GpuContext,
     mut shadowing: Option<&mut VisibilityStage>,
     statics: Option<(&StaticShadowingStage, &lightsphere::Environment)>,
+    mut volumes: Option<&mut ShadowVolumeStage>,
     renderer: &mut Renderer,
     objects: &mut [WorldObject],
     lights: Option<&Lights>,
@@ -620,8 +665,9 @@ fn render_sequence(
 ) -> Result<(HdrImage, Vec<PathBuf>), Error> {
     let bar = progress_bar(progress, range.len() as u64, "rendering frames");
     let (mut pose_t, mut vis_t, mut light_t, mut render_t, mut write_t) = Default::default();
-    let mut static_t = FrameTimes::default();
+    let (mut static_t, mut volume_t) = (FrameTimes::default(), FrameTimes::default());
     let (mut vis_params, mut light_params, mut static_params) = (json!({}), json!({}), json!({}));
+    let mut volume_params = json!({});
     let mut display: Option<Display> = None;
     let mut written = Vec::new();
     let mut last = None;
@@ -652,9 +698,22 @@ fn render_sequence(
             static_params = stage.light(Some(gpu), objects, env)?;
             FrameTimes::add(&mut static_t, ms_since(t));
         }
+        if let Some(stage) = volumes.as_deref_mut() {
+            let t = Instant::now();
+            volume_params = stage.prepare(scene, gpu, objects)?;
+            FrameTimes::add(&mut volume_t, ms_since(t));
+        }
+        let passes: Vec<&dyn FramePass> =
+            volumes.iter().map(|v| v.pass() as &dyn FramePass).collect();
         let t = Instant::now();
         set_gouraud_meshes(gpu, renderer, objects, &look.camera, &[])?;
-        let image = renderer.render(&gpu.device, &gpu.queue, &look.camera, look.background, &[])?;
+        let image = renderer.render(
+            &gpu.device,
+            &gpu.queue,
+            &look.camera,
+            look.background,
+            &passes,
+        )?;
         crate::image_checks::check_rendered(scene, &image, Some(f))?;
         FrameTimes::add(&mut render_t, ms_since(t));
         let t = Instant::now();
@@ -670,7 +729,7 @@ fn render_sequence(
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let times: [(Stage, &FrameTimes, serde_json::Value); 5] = [
+    let times: [(Stage, &FrameTimes, serde_json::Value); 6] = [
         (
             Stage::Geometry,
             &pose_t,
@@ -679,6 +738,7 @@ fn render_sequence(
         (Stage::Visibility, &vis_t, vis_params),
         (Stage::StaticVisibility, &static_t, static_params),
         (Stage::Lighting, &light_t, light_params),
+        (Stage::ShadowVolumes, &volume_t, volume_params),
         (
             Stage::Render,
             &render_t,

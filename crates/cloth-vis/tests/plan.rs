@@ -86,21 +86,21 @@ fn an_effect_not_built_yet_is_refused_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
     let text = format!(
-        "effects = [\"lighting\", \"shadow-volumes\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
+        "effects = [\"lighting\", \"translucency\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
     );
     let err = run_scene(&scene(&text, dir.path()), &out, &RunOptions::default()).unwrap_err();
     assert!(
         matches!(
             err,
             Error::EffectNotBuilt {
-                effect: "shadow-volumes",
-                provider: "shadows",
+                effect: "translucency",
+                provider: "translucency",
                 ..
             }
         ),
         "{err}"
     );
-    assert!(err.to_string().contains("\"shadow-volumes\""), "{err}");
+    assert!(err.to_string().contains("\"translucency\""), "{err}");
     assert!(
         !out.exists(),
         "no output folder may be created before validation passes"

@@ -395,6 +395,12 @@ impl ShadowVolume {
         &self.vertices
     }
 
+    /// Empty the volume, keeping its buffers (to [`ShadowVolume::append`] casters into).
+    pub fn clear(&mut self) {
+        self.vertices.clear();
+        self.stats = VolumeStats::default();
+    }
+
     /// Append the triangles of `other`, built for the same light, origin and extrusion:
     /// several casters drawn as one volume (the counts add, lit ⇔ 0 still holds).
     pub fn append(&mut self, other: &ShadowVolume) {

@@ -13,6 +13,7 @@ pub mod inspect;
 pub mod jumpmap;
 pub mod parse;
 pub mod render;
+pub mod shadows;
 pub mod visibility;
 
 #[cfg(test)]

@@ -37,12 +37,14 @@ use crate::{Effect, Error};
 
 mod btf_table;
 mod output;
+mod shadow_table;
 mod static_table;
 
 pub use btf_table::BtfDesc;
 pub use output::{
     AutoKeyword, BackgroundDesc, BackgroundKeyword, ExposureDesc, GroundDesc, OutputDesc, ToneDesc,
 };
+pub use shadow_table::{ShadowLightDesc, ShadowVolumesDesc};
 pub use static_table::{StaticBuilderDesc, StaticShadowingDesc};
 
 /// Prefix of procedural sources in scene files.
@@ -97,6 +99,9 @@ pub struct Scene {
     pub btf: BtfDesc,
     /// An optional ground plane under the objects.
     pub ground: Option<GroundDesc>,
+    /// Hard shadows (the `shadow-volumes` effect).
+    #[serde(default)]
+    pub shadow_volumes: ShadowVolumesDesc,
     /// Folder that relative paths are resolved against (the scene file's folder).
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -593,6 +598,9 @@ impl Scene {
                 ));
             }
             self.validate_static_shadowing()?;
+        }
+        if effects.contains(&Effect::ShadowVolumes) {
+            self.validate_shadow_volumes()?;
         }
         let lit = effects.iter().find(|e| {
             matches!(

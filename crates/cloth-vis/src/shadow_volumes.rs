@@ -1,0 +1,261 @@
+//! The `shadow-volumes` stage: hard shadows of the scene's casters for each of its lights,
+//! counted in the frame's stencil and masking each light's direct term (crate `shadows`;
+//! thesis §2.4.1, §4.2, §5.5.1).
+//!
+//! Per frame (a deforming cloth changes its silhouette every frame): each caster's volume is
+//! rebuilt for each light into reusable buffers (its LOD triangles index the object's current
+//! positions, so a simplified caster follows the deformation), the receivers — every object
+//! and the ground — are handed over with their positions and normals, and the frame records,
+//! per light, stencil reset → volumes → direct light where the count is 0, through eq. 5.6's
+//! boundary texture. The frame uses the reversed-infinite depth (volumes reach infinity).
+//!
+//! The procedural sky's sun as a light (`sun = true`) has the direction of the sky's sun and
+//! the irradiance E = L̄_sun · Ω_sun of its disc (mean radiance × solid angle); the sky that
+//! lights the vertices is then generated without the sun, so its energy is counted once.
+
+use glam::{DVec3, Vec3};
+use gpu_context::GpuContext;
+use render::Renderer;
+use serde_json::json;
+use shadows::frame::{FrameLight, Receiver, SmoothBoundary, StencilShadows};
+use shadows::volume::{CasterTopology, Extrusion, ShadowVolume, Sides, VolumeParams};
+use shadows::{BoundaryTexture, Counting, Light, LodTarget};
+
+use crate::Error;
+use crate::inputs::sky_params;
+use crate::object::WorldObject;
+use crate::scene::{GROUND_NAME, Scene};
+
+/// One casting object.
+struct Caster {
+    object: usize,
+    topology: CasterTopology,
+    sides: Sides,
+    offset: f64,
+}
+
+/// The stage: the effect pass (pipelines built once), casters, lights and volume buffers.
+pub struct ShadowVolumeStage {
+    effect: StencilShadows,
+    casters: Vec<Caster>,
+    lights: Vec<(Light, Vec3)>,
+    boundary: Option<SmoothBoundary>,
+    volumes: Vec<ShadowVolume>,
+    scratch: ShadowVolume,
+    ambient: f32,
+}
+
+impl ShadowVolumeStage {
+    /// Build the pass against `renderer`'s frame (which must use the reversed-infinite depth),
+    /// the casters' topologies and levels, and the lights. Returns the stage and what the run
+    /// report records.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] for a caster LOD that fails or a frame without reversed depth or float
+    /// blending.
+    pub fn new(
+        scene: &Scene,
+        gpu: &GpuContext,
+        renderer: &Renderer,
+        objects: &[WorldObject],
+    ) -> Result<(Self, serde_json::Value), Error> {
+        let desc = &scene.shadow_volumes;
+        let invalid = |key: &str, e: shadows::ShadowError| scene.invalid(key, e.to_string());
+        let texture =
+            BoundaryTexture::blurred(shadows::boundary::TEXTURE_TEXELS, desc.blur, desc.alpha_deg)
+                .map_err(|e| invalid("shadow_volumes.blur", e))?;
+        let effect = StencilShadows::new(
+            &gpu.device,
+            &renderer.pass_context(),
+            &texture,
+            Counting::ZFail,
+        )
+        .map_err(|e| invalid("shadow_volumes", e))?;
+        let lod = desc
+            .lod
+            .as_deref()
+            .map(LodTarget::parse)
+            .transpose()
+            .map_err(|e| invalid("shadow_volumes.lod", e))?;
+        let mut casters = Vec::new();
+        let mut caster_params = Vec::new();
+        for (index, o) in objects.iter().enumerate() {
+            let named = desc.casters.is_empty() || desc.casters.contains(&o.name);
+            if o.name == GROUND_NAME || !named || o.triangles.is_empty() {
+                continue;
+            }
+            let (triangles, offset, hausdorff) = match lod {
+                Some(target) => {
+                    let level = shadows::caster_lod(
+                        &o.positions,
+                        &o.triangles,
+                        target,
+                        shadows::lod::DEFAULT_SAMPLES,
+                        0,
+                    )
+                    .map_err(|e| invalid("shadow_volumes.lod", e))?;
+                    let offset = level.receiver_offset();
+                    let percent = level.hausdorff.percent();
+                    (level.triangles, offset, Some(percent))
+                }
+                None => (o.triangles.clone(), 0.0, None),
+            };
+            caster_params.push(json!({
+                "object": o.name,
+                "triangles": o.triangles.len(),
+                "caster_triangles": triangles.len(),
+                "hausdorff_percent": hausdorff,
+                "offset": offset,
+                "two_sided": o.two_sided,
+            }));
+            casters.push(Caster {
+                object: index,
+                topology: CasterTopology::new(o.positions.len(), &triangles)
+                    .map_err(|e| invalid("shadow_volumes.casters", e))?,
+                sides: if o.two_sided { Sides::Two } else { Sides::One },
+                offset,
+            });
+        }
+        let lights = scene_lights(scene)?;
+        let boundary = desc.boundary_mode().flatten().map(|mode| SmoothBoundary {
+            alpha_deg: desc.alpha_deg,
+            mode,
+        });
+        let params = json!({
+            "casters": caster_params,
+            "lights": lights.len(),
+            "boundary": desc.boundary,
+            "alpha_deg": desc.alpha_deg,
+            "blur": desc.blur,
+            "lod": desc.lod,
+        });
+        Ok((
+            Self {
+                effect,
+                volumes: (0..lights.len()).map(|_| ShadowVolume::new()).collect(),
+                casters,
+                lights,
+                boundary,
+                scratch: ShadowVolume::new(),
+                ambient: desc.ambient,
+            },
+            params,
+        ))
+    }
+
+    /// Rebuild every volume for the objects' current positions and hand receivers and lights
+    /// to the pass; objects that no other effect lit get the ambient radiance. Returns what
+    /// the run report records of the frame.
+    ///
+    /// # Errors
+    /// [`Error::Scene`] when a caster's positions are not finite.
+    pub fn prepare(
+        &mut self,
+        scene: &Scene,
+        gpu: &GpuContext,
+        objects: &mut [WorldObject],
+    ) -> Result<serde_json::Value, Error> {
+        let invalid = |e: shadows::ShadowError| scene.invalid("shadow_volumes", e.to_string());
+        for o in objects.iter_mut() {
+            if o.front.is_none() || o.back.is_none() {
+                let c = vec![o.albedo * self.ambient; o.positions.len()];
+                o.front = Some(c.clone());
+                o.back = Some(c);
+            }
+        }
+        let mut triangles = 0;
+        for (volume, (light, _)) in self.volumes.iter_mut().zip(&self.lights) {
+            volume.clear();
+            for caster in &self.casters {
+                let params = VolumeParams {
+                    sides: caster.sides,
+                    extrusion: Extrusion::Infinite,
+                    origin: DVec3::ZERO,
+                    offset: caster.offset,
+                };
+                self.scratch
+                    .build(
+                        &caster.topology,
+                        &objects[caster.object].positions,
+                        light,
+                        &params,
+                    )
+                    .map_err(invalid)?;
+                volume.append(&self.scratch);
+            }
+            triangles += volume.stats().triangles();
+        }
+        let albedo: Vec<Vec<Vec3>> = objects
+            .iter()
+            .map(|o| vec![o.albedo; o.positions.len()])
+            .collect();
+        let receivers: Vec<Receiver> = objects
+            .iter()
+            .zip(&albedo)
+            .map(|(o, albedo)| Receiver {
+                positions: &o.positions,
+                normals: &o.normals,
+                albedo,
+                triangles: &o.triangles,
+            })
+            .collect();
+        self.effect
+            .set_receivers(&gpu.device, &receivers)
+            .map_err(invalid)?;
+        let lights: Vec<FrameLight> = self
+            .lights
+            .iter()
+            .zip(&self.volumes)
+            .map(|((light, intensity), volume)| FrameLight {
+                light: *light,
+                intensity: *intensity,
+                volume,
+                boundary: self.boundary,
+            })
+            .collect();
+        self.effect
+            .set_lights(&gpu.device, &gpu.queue, &lights)
+            .map_err(invalid)?;
+        Ok(json!({ "volume_triangles": triangles }))
+    }
+
+    /// The pass to hand to the renderer.
+    pub fn pass(&self) -> &StencilShadows {
+        &self.effect
+    }
+}
+
+/// The scene's lights: the sky's sun (direction rotated with the environment, irradiance of
+/// its disc), directional and point lights.
+///
+/// # Errors
+/// [`Error::Scene`] when the sky's parameters are invalid.
+pub fn scene_lights(scene: &Scene) -> Result<Vec<(Light, Vec3)>, Error> {
+    let mut lights = Vec::new();
+    for desc in &scene.shadow_volumes.lights {
+        lights.push(if desc.sun {
+            let params = sky_params(scene);
+            let radiance = synth::sun_radiance(&params)?;
+            let radius = f64::from(params.sun_angular_radius_deg).to_radians();
+            let solid_angle = 2.0 * std::f64::consts::PI * (1.0 - radius.cos());
+            let rotation = scene.environment.as_ref().map_or(0.0, |e| e.rotation_deg);
+            let direction =
+                crate::lighting::environment_rotation(rotation) * synth::sun_direction(&params);
+            (
+                Light::Directional(direction.as_dvec3()),
+                radiance * solid_angle as f32,
+            )
+        } else if let Some(d) = desc.direction {
+            (
+                Light::Directional(DVec3::from_array(d)),
+                Vec3::from_array(desc.irradiance.unwrap_or_default()),
+            )
+        } else {
+            (
+                Light::Point(DVec3::from_array(desc.position.unwrap_or_default())),
+                Vec3::from_array(desc.intensity.unwrap_or_default()),
+            )
+        });
+    }
+    Ok(lights)
+}
