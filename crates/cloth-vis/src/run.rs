@@ -183,10 +183,9 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         render::DepthConvention::Standard
     };
     let (mut renderer, background, format) = renderer_for(scene, &gpu, environment.as_ref(), depth);
+    // Its setup time (caster levels) is reported with its first frame.
     let mut volumes = if volumes_planned {
-        Some(timer.run(Stage::ShadowVolumes, || {
-            ShadowVolumeStage::new(scene, &gpu, &renderer, &objects)
-        })?)
+        Some(ShadowVolumeStage::new(scene, &gpu, &renderer, &objects)?)
     } else {
         None
     };

@@ -43,12 +43,13 @@ pub struct ShadowVolumeStage {
     volumes: Vec<ShadowVolume>,
     scratch: ShadowVolume,
     ambient: f32,
+    /// What the run report records of the setup (casters, levels, lights, time).
+    setup: serde_json::Value,
 }
 
 impl ShadowVolumeStage {
     /// Build the pass against `renderer`'s frame (which must use the reversed-infinite depth),
-    /// the casters' topologies and levels, and the lights. Returns the stage and what the run
-    /// report records.
+    /// the casters' topologies and levels, and the lights.
     ///
     /// # Errors
     /// [`Error::Scene`] for a caster LOD that fails or a frame without reversed depth or float
@@ -58,7 +59,8 @@ impl ShadowVolumeStage {
         gpu: &GpuContext,
         renderer: &Renderer,
         objects: &[WorldObject],
-    ) -> Result<(Self, serde_json::Value), Error> {
+    ) -> Result<Self, Error> {
+        let start = std::time::Instant::now();
         let desc = &scene.shadow_volumes;
         let invalid = |key: &str, e: shadows::ShadowError| scene.invalid(key, e.to_string());
         let texture =
@@ -121,31 +123,31 @@ impl ShadowVolumeStage {
             alpha_deg: desc.alpha_deg,
             mode,
         });
-        let params = json!({
+        let setup = json!({
             "casters": caster_params,
             "lights": lights.len(),
             "boundary": desc.boundary,
             "alpha_deg": desc.alpha_deg,
             "blur": desc.blur,
             "lod": desc.lod,
+            "setup_ms": start.elapsed().as_secs_f64() * 1e3,
         });
-        Ok((
-            Self {
-                effect,
-                volumes: (0..lights.len()).map(|_| ShadowVolume::new()).collect(),
-                casters,
-                lights,
-                boundary,
-                scratch: ShadowVolume::new(),
-                ambient: desc.ambient,
-            },
-            params,
-        ))
+        Ok(Self {
+            effect,
+            volumes: (0..lights.len()).map(|_| ShadowVolume::new()).collect(),
+            casters,
+            lights,
+            boundary,
+            scratch: ShadowVolume::new(),
+            ambient: desc.ambient,
+            setup,
+        })
     }
 
     /// Rebuild every volume for the objects' current positions and hand receivers and lights
     /// to the pass; objects that no other effect lit get the ambient radiance. Returns what
-    /// the run report records of the frame.
+    /// the run report records: the setup (casters, levels, lights, `setup_ms`) and the frame's
+    /// volume triangles.
     ///
     /// # Errors
     /// [`Error::Scene`] when a caster's positions are not finite.
@@ -216,7 +218,11 @@ impl ShadowVolumeStage {
         self.effect
             .set_lights(&gpu.device, &gpu.queue, &lights)
             .map_err(invalid)?;
-        Ok(json!({ "volume_triangles": triangles }))
+        let mut params = self.setup.clone();
+        if let serde_json::Value::Object(map) = &mut params {
+            map.insert("volume_triangles".into(), json!(triangles));
+        }
+        Ok(params)
     }
 
     /// The pass to hand to the renderer.

@@ -98,7 +98,7 @@ fn demo_writes_non_constant_png_exr_and_a_report_of_the_planned_stages() {
             .unwrap();
     assert_eq!(
         json["effects"],
-        serde_json::json!(["lighting", "self-shadowing", "btf"])
+        serde_json::json!(["lighting", "self-shadowing", "btf", "shadow-volumes"])
     );
     let vis = json["stages"]
         .as_array()

@@ -41,6 +41,7 @@ fn the_demo_scene_plans_lighting() {
             Stage::LightDirections,
             Stage::Visibility,
             Stage::Lighting,
+            Stage::ShadowVolumes,
             Stage::Render,
             Stage::Btf
         ]
@@ -278,4 +279,75 @@ fn bad_static_shadowing_tables_are_named_before_any_work() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("environment"), "{err}");
+}
+
+#[test]
+fn bad_shadow_volume_tables_are_named_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let sun = "[[shadow_volumes.light]]\nsun = true\n";
+    let sky = "[environment]\nsource = \"synth:sky\"\n";
+    for (table, key) in [
+        (String::new(), "shadow_volumes.light"),
+        (
+            format!("{sun}direction = [0.0, 1.0, 0.0]\n{sky}"),
+            "shadow_volumes.light[0]",
+        ),
+        (sun.to_owned(), "shadow_volumes.light[0].sun"),
+        (
+            "[[shadow_volumes.light]]\ndirection = [0.0, 0.0, 0.0]\nirradiance = [1.0, 1.0, 1.0]\n"
+                .to_owned(),
+            "shadow_volumes.light[0].direction",
+        ),
+        (
+            "[[shadow_volumes.light]]\ndirection = [0.0, 1.0, 0.0]\n".to_owned(),
+            "shadow_volumes.light[0].irradiance",
+        ),
+        (
+            "[[shadow_volumes.light]]\nposition = [0.0, 1.0, 0.0]\nintensity = [-1.0, 1.0, 1.0]\n"
+                .to_owned(),
+            "shadow_volumes.light[0].intensity",
+        ),
+        (
+            format!("[shadow_volumes]\ncasters = [\"shirt\"]\n{sun}{sky}"),
+            "shadow_volumes.casters",
+        ),
+        (
+            format!("[shadow_volumes]\nlod = \"2.0\"\n{sun}{sky}"),
+            "shadow_volumes.lod",
+        ),
+        (
+            format!("[shadow_volumes]\nboundary = \"soft\"\n{sun}{sky}"),
+            "shadow_volumes.boundary",
+        ),
+        (
+            format!("[shadow_volumes]\nalpha_deg = 90.0\n{sun}{sky}"),
+            "shadow_volumes.alpha_deg",
+        ),
+        (
+            format!("[shadow_volumes]\nblur = 2.0\n{sun}{sky}"),
+            "shadow_volumes.blur",
+        ),
+        (
+            format!("[shadow_volumes]\nambient = -1.0\n{sun}{sky}"),
+            "shadow_volumes.ambient",
+        ),
+    ] {
+        let text = format!("effects = [\"shadow-volumes\"]\n{CLOTH}\n{table}");
+        let err = Plan::for_scene(&scene(&text, dir.path()))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(key), "{table}: {err}");
+    }
+    let ok = format!("effects = [\"shadow-volumes\"]\n{CLOTH}\n{sun}{sky}");
+    let plan = Plan::for_scene(&scene(&ok, dir.path())).unwrap();
+    assert_eq!(
+        plan.stages(),
+        // The sky is drawn as the backdrop; nothing lights through it.
+        &[
+            Stage::Geometry,
+            Stage::Environment,
+            Stage::ShadowVolumes,
+            Stage::Render
+        ]
+    );
 }

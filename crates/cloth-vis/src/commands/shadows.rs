@@ -38,17 +38,17 @@ pub struct ShadowsArgs {
     #[arg(long, default_value_t = 0)]
     frame: usize,
     /// A point light at X,Y,Z.
-    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, allow_negative_numbers = true,
+    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, allow_hyphen_values = true,
           conflicts_with = "light_dir", required_unless_present = "light_dir")]
     light_pos: Option<Vec3>,
     /// A directional light: the direction X,Y,Z towards it.
-    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, allow_negative_numbers = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, allow_hyphen_values = true)]
     light_dir: Option<Vec3>,
     /// Height Y of the ground plane y = Y.
     #[arg(long, value_name = "Y", allow_negative_numbers = true)]
     ground: f64,
     /// The sampled extent X0,Z0,X1,Z1 (default: the mesh's x/z box scaled ×3 about its centre).
-    #[arg(long, value_name = "X0,Z0,X1,Z1", value_parser = parse_extent, allow_negative_numbers = true)]
+    #[arg(long, value_name = "X0,Z0,X1,Z1", value_parser = parse_extent, allow_hyphen_values = true)]
     ground_extent: Option<[f64; 4]>,
     /// Cells per side of the mask.
     #[arg(long, value_name = "N", default_value_t = 512)]
@@ -311,7 +311,7 @@ impl ShadowsArgs {
         let mut objects = vec![mesh, ground];
         let format = FrameFormat::for_context(gpu).with_depth(DepthConvention::ReversedInfinite);
         let mut renderer = Renderer::new(&gpu.device, format);
-        let (mut stage, _) = ShadowVolumeStage::new(&scene, gpu, &renderer, &objects)?;
+        let mut stage = ShadowVolumeStage::new(&scene, gpu, &renderer, &objects)?;
         stage.prepare(&scene, gpu, &mut objects)?;
         let meshes: Vec<DrawMesh> = objects
             .iter()

@@ -9,5 +9,6 @@ mod anim_search;
 mod hemicube_cmd;
 mod inspect_cmd;
 mod render_outputs;
+mod shadows_cmd;
 mod visibility_cmd;
 mod visibility_outputs;

@@ -1,0 +1,182 @@
+//! `cloth-vis shadows` through the binary: the mask of a square over the ground by stencil and
+//! by rays against the cells it must cover, the row/column convention of the issue, LOD
+//! casters, the rendered picture, and refusals naming the flag and value before any output.
+
+use std::path::Path;
+
+use super::common::{cli, text};
+
+/// A unit square at height 1 centred over (0.25, 0), wound to face down (the light is above:
+/// one-sided casting would drop it, two-sided must keep it; the command picks two-sided for a
+/// mesh with border edges).
+fn square(dir: &Path) -> std::path::PathBuf {
+    let path = dir.join("square.obj");
+    std::fs::write(
+        &path,
+        "v -0.25 1 -0.5\nv 0.75 1 -0.5\nv 0.75 1 0.5\nv -0.25 1 0.5\nf 1 2 3\nf 1 3 4\n",
+    )
+    .unwrap();
+    path
+}
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = cli(args);
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn gpu() -> bool {
+    gpu_context::testing::gpu_or_skip().is_some()
+}
+
+#[test]
+fn the_mask_covers_the_squares_shadow_in_the_issues_row_and_column_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = square(dir.path());
+    // Extent x ∈ [−1, 1] (8 columns of 0.25), z ∈ [−2, 2] (8 rows of 0.5); the light straight
+    // above projects the square onto x ∈ [−0.25, 0.75], z ∈ [−0.5, 0.5]: columns 3..=6, rows
+    // 3..=4.
+    let expected: Vec<f32> = (0..8)
+        .flat_map(|j| {
+            (0..8).map(move |i| f32::from(u8::from((3..=6).contains(&i) && (3..=4).contains(&j))))
+        })
+        .collect();
+    let mut modes = vec!["--cpu"];
+    if gpu() {
+        modes.push("--sides=auto");
+    }
+    for mode in modes {
+        let out = dir.path().join(format!("mask{}.npy", mode.len()));
+        let (ok, stdout, stderr) = run(&[
+            "shadows",
+            text(&input),
+            "--light-dir",
+            "0,1,0",
+            "--ground",
+            "0",
+            "--ground-extent",
+            "-1,-2,1,2",
+            "--grid",
+            "8",
+            mode,
+            "--out",
+            text(&out),
+        ]);
+        assert!(ok, "{mode}: {stderr}");
+        assert!(
+            stdout.starts_with("shadows: 2 triangles (caster) in "),
+            "{stdout}"
+        );
+        assert!(stdout.contains("Two-sided"), "{stdout}");
+        let mask = meshio::read_npy_f32(&out).unwrap();
+        assert_eq!(mask.shape, [8, 8]);
+        assert_eq!(mask.data, expected, "{mode}");
+    }
+}
+
+#[test]
+fn a_lod_caster_and_a_picture() {
+    if !gpu() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A closed icosphere written as OBJ: 1,280 triangles.
+    let (positions, triangles) = synth::obstacle_mesh(
+        &synth::Obstacle::Sphere {
+            centre: glam::Vec3::new(0.0, 2.0, 0.0),
+            radius: 1.0,
+        },
+        3,
+    );
+    let mut obj = String::new();
+    for p in &positions {
+        obj.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    for t in &triangles {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+    }
+    let input = dir.path().join("ball.obj");
+    std::fs::write(&input, obj).unwrap();
+    let (out, picture) = (dir.path().join("m.npy"), dir.path().join("m.png"));
+    let (ok, stdout, stderr) = run(&[
+        "shadows",
+        text(&input),
+        "--light-pos",
+        "0.3,6,0.2",
+        "--ground",
+        "0",
+        "--grid",
+        "64",
+        "--lod",
+        "hard",
+        "--out",
+        text(&out),
+        "--render",
+        text(&picture),
+        "--render-size",
+        "96x96",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(
+        stdout.starts_with("shadows: 128 triangles (caster)"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("One-sided") && stdout.contains("Hausdorff"),
+        "{stdout}"
+    );
+    assert!(picture.is_file());
+    // The disc of the sphere (radius 6/√15 = 1.55 from the formula) in the default extent
+    // (x, z ∈ [−3, 3]): about π·1.55²/36 = 21 % of the cells.
+    let mask = meshio::read_npy_f32(&out).unwrap();
+    let share = mask.data.iter().sum::<f32>() / mask.data.len() as f32;
+    assert!((share - 0.21).abs() < 0.03, "{share}");
+}
+
+#[test]
+fn bad_flags_are_refused_before_any_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = square(dir.path());
+    let out = dir.path().join("never.npy");
+    for (flags, expected) in [
+        (vec!["--light-dir", "0,0,0"], "--light-dir"),
+        (vec!["--light-dir", "0,1,0", "--grid", "0"], "grid = 0"),
+        (vec!["--light-dir", "0,1,0", "--lod", "1.5"], "--lod"),
+        (vec!["--light-dir", "0,1,0", "--alpha", "90"], "--alpha"),
+        (
+            vec!["--light-dir", "0,1,0", "--ground-extent", "1,0,0,1"],
+            "ground extent",
+        ),
+        (vec!["--light-pos", "0,nan,0"], "not finite"),
+    ] {
+        let mut args = vec![
+            "shadows",
+            text(&input),
+            "--ground",
+            "0",
+            "--cpu",
+            "--out",
+            text(&out),
+        ];
+        args.extend(flags.iter().copied());
+        let (ok, _, stderr) = run(&args);
+        assert!(!ok, "{flags:?} was accepted");
+        assert!(stderr.contains(expected), "{flags:?}: {stderr}");
+        assert!(!out.exists(), "{flags:?} left an output");
+    }
+    let (ok, _, stderr) = run(&[
+        "shadows",
+        text(&input),
+        "--ground",
+        "0",
+        "--light-dir",
+        "0,1,0",
+        "--cpu",
+        "--out",
+        text(&dir.path().join("mask.txt")),
+    ]);
+    assert!(!ok && stderr.contains(".npy"), "{stderr}");
+}
