@@ -107,6 +107,8 @@ pub struct CasterTopology {
     /// `uses[offsets[e]..offsets[e + 1]]` are the faces of edge `e`.
     offsets: Vec<u32>,
     uses: Vec<EdgeUse>,
+    /// Vertices some triangle uses, ascending.
+    used: Vec<u32>,
 }
 
 impl CasterTopology {
@@ -153,7 +155,11 @@ impl CasterTopology {
             uses.push(EdgeUse { face, forward });
         }
         offsets.push(uses.len() as u32);
+        let mut used: Vec<u32> = triangles.iter().flatten().copied().collect();
+        used.sort_unstable();
+        used.dedup();
         Ok(Self {
+            used,
             vertex_count,
             triangles: triangles.to_vec(),
             edges,
@@ -262,7 +268,7 @@ impl ShadowVolume {
         }
         self.orient_faces(topology, positions, &light, params.sides);
         self.offset_vertices(topology, positions, &light, params);
-        self.extrude_vertices(&light, params);
+        self.extrude_vertices(topology, &light, params);
         self.assemble(topology);
         Ok(self.stats)
     }
@@ -306,13 +312,18 @@ impl ShadowVolume {
         light: &Light,
         params: &VolumeParams,
     ) {
-        self.moved.clear();
-        self.moved.extend(positions.iter().map(|p| p.as_dvec3()));
+        // Only the vertices the caster's triangles use: a 1 % level touches 1 % of them.
+        self.moved.resize(positions.len(), DVec3::ZERO);
+        for &i in &topology.used {
+            self.moved[i as usize] = positions[i as usize].as_dvec3();
+        }
         if params.offset == 0.0 {
             return;
         }
-        self.normals.clear();
         self.normals.resize(positions.len(), DVec3::ZERO);
+        for &i in &topology.used {
+            self.normals[i as usize] = DVec3::ZERO;
+        }
         for t in &topology.triangles {
             let [a, b, c] = t.map(|i| self.moved[i as usize]);
             let n = (b - a).cross(c - a);
@@ -320,7 +331,8 @@ impl ShadowVolume {
                 self.normals[i as usize] += n;
             }
         }
-        for (v, n) in self.moved.iter_mut().zip(&self.normals) {
+        for &i in &topology.used {
+            let (v, n) = (&mut self.moved[i as usize], self.normals[i as usize]);
             let n = n.normalize_or_zero();
             let side = match params.sides {
                 Sides::One => 1.0,
@@ -331,21 +343,26 @@ impl ShadowVolume {
         }
     }
 
-    fn extrude_vertices(&mut self, light: &Light, params: &VolumeParams) {
-        self.near.clear();
-        self.far.clear();
-        for &v in &self.moved {
+    fn extrude_vertices(
+        &mut self,
+        topology: &CasterTopology,
+        light: &Light,
+        params: &VolumeParams,
+    ) {
+        self.near.resize(self.moved.len(), [0.0; 4]);
+        self.far.resize(self.moved.len(), [0.0; 4]);
+        for &i in &topology.used {
+            let v = self.moved[i as usize];
             let rel = v - params.origin;
-            self.near
-                .push([rel.x as f32, rel.y as f32, rel.z as f32, 1.0]);
+            self.near[i as usize] = [rel.x as f32, rel.y as f32, rel.z as f32, 1.0];
             let away = -light.to_light(v);
-            self.far.push(match params.extrusion {
+            self.far[i as usize] = match params.extrusion {
                 Extrusion::Infinite => [away.x as f32, away.y as f32, away.z as f32, 0.0],
                 Extrusion::Finite(d) => {
                     let e = rel + away.normalize_or_zero() * d;
                     [e.x as f32, e.y as f32, e.z as f32, 1.0]
                 }
-            });
+            };
         }
     }
 
