@@ -24,6 +24,11 @@
 //!   dress — Table 4.1 rebuilt (GPU atlas and exact rays beside the thesis's four builders),
 //!   HC 64² of the whole dress, convergence of HC/SP/HS against an HC 256² reference, the
 //!   lightsphere's a_i beside it, bytes per vertex (`target/repro/hemicube.md`, `hemicube.svg`).
+//! - `cargo xtask repro shadows [--quick]`: shadow volumes (thesis §2.4.1, §4.2, §5.5.1) — the
+//!   LOD chain on the bunny (Hausdorff %, hard- and soft-mask error, build and mask times, the
+//!   speed-up beside the thesis's), the zig-zag of the stencil's terminator against eq. 5.6's
+//!   on spheres and cylinders, popping under sun motion on the drape (`target/repro/shadows.md`,
+//!   `shadows-lod.svg`, `shadows-zigzag.svg`, `shadows-popping.svg`).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 
@@ -34,6 +39,7 @@ mod repro_hemicube;
 mod repro_jumpmap;
 mod repro_lightsphere;
 mod repro_rd_search;
+mod repro_shadows;
 mod repro_visibility;
 mod sequences;
 
@@ -113,6 +119,14 @@ enum Repro {
         #[arg(long)]
         quick: bool,
     },
+    /// Shadow volumes (thesis §2.4.1, §4.2, §5.5.1): the LOD chain on the bunny (Hausdorff,
+    /// mask error, soft-mask error, build and mask times), the zig-zag against tessellation,
+    /// popping under sun motion on the drape.
+    Shadows {
+        /// 256² masks, three levels, fewer tessellations and sun steps.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Static visibility maps (thesis §4.3): Table 4.1 rebuilt on the shared dress, convergence
     /// of HC/SP/HS against an HC 256² reference, the lightsphere's a_i beside it, bytes per
     /// vertex.
@@ -152,6 +166,9 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Hemicube { quick },
         } => repro_hemicube::run(&repro_dir()?, quick),
+        Command::Repro {
+            what: Repro::Shadows { quick },
+        } => repro_shadows::run(&repro_dir()?, quick),
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {
