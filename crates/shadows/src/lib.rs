@@ -13,7 +13,9 @@
 //! * [`lod`]: caster levels by meshoptimizer's simplifier, sampled symmetric Hausdorff distance
 //!   in % of the diagonal, the `soft` (1 %) and `hard` (10 %) presets of §4.2.
 //! * [`ground`]: a receiver plane sampled on a grid and its exact mask by rays through
-//!   occlusion-gpu's BVH — the twin every stencil result is checked against.
+//!   occlusion-gpu's BVH — the twin every stencil result is checked against; and
+//!   [`exact_view_mask`], the exact mask of any camera's view (first hit per pixel, then its
+//!   segment to the light).
 //! * `gpu` (feature `gpu`, default): the z-fail stencil pipeline and the ground mask seen by an
 //!   orthographic camera from above ([`stencil_ground_mask`]); `frame`: the effect in the
 //!   render crate's shared frame — per light, stencil reset, volumes, and the light's direct
@@ -58,6 +60,7 @@ mod gpu;
 pub mod ground;
 mod light;
 pub mod lod;
+mod view;
 pub mod volume;
 
 pub use boundary::{BoundaryMode, BoundaryTexture, DEFAULT_ALPHA_DEG, boundary_u};
@@ -70,3 +73,4 @@ pub use gpu::{
 pub use ground::{GroundGrid, exact_ground_mask};
 pub use light::Light;
 pub use lod::{Hausdorff, LodLevel, LodTarget, caster_lod, hausdorff, simplify};
+pub use view::exact_view_mask;

@@ -46,3 +46,131 @@ fn two_lights_accumulate_and_the_ambient_term_stays_in_shadow() {
     ];
     check("two lights", camera, &lights, 0.05, true);
 }
+
+/// The whole frame against [`shadows::exact_view_mask`]: a faceted sphere that casts on
+/// itself and on the ground, both receivers (facet normals, so the light's term is dark
+/// exactly where the facet faces away, as the exact mask's own-surface test is).
+#[test]
+fn the_frame_equals_the_exact_mask_of_its_view() {
+    use render::{Background, DepthConvention, DrawMesh, FrameFormat, Renderer};
+    use shadows::frame::{FrameLight, Receiver, StencilShadows};
+    use shadows::volume::{CasterTopology, ShadowVolume, VolumeParams};
+    use shadows::{BoundaryTexture, Counting};
+    let Some(gpu) = gpu_context::testing::gpu_or_skip() else {
+        return;
+    };
+    let s = scenery();
+    // Unwelded sphere (facet normals) and the ground, drawn black; all receive.
+    let mut positions = Vec::new();
+    let mut normals = Vec::new();
+    for t in &s.caster.1 {
+        let [a, b, c] = t.map(|i| s.caster.0[i as usize]);
+        let n = (b - a).cross(c - a).normalize();
+        positions.extend([a, b, c]);
+        normals.extend([n; 3]);
+    }
+    let facets: Vec<[u32; 3]> = (0..s.caster.1.len() as u32)
+        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+        .collect();
+    let meshes = [
+        (&positions, &facets, normals.clone()),
+        (&s.ground.0, &s.ground.1, vec![Vec3::Y; 4]),
+    ];
+    let format =
+        FrameFormat::single_sample(&gpu.device).with_depth(DepthConvention::ReversedInfinite);
+    let mut renderer = Renderer::new(&gpu.device, format);
+    let blacks: Vec<Vec<Vec3>> = meshes.iter().map(|m| vec![Vec3::ZERO; m.0.len()]).collect();
+    let draws: Vec<DrawMesh> = meshes
+        .iter()
+        .zip(&blacks)
+        .map(|(m, b)| DrawMesh {
+            positions: m.0,
+            triangles: m.1,
+            front: b,
+            back: b,
+        })
+        .collect();
+    renderer
+        .gouraud
+        .set_meshes(&gpu.device, &gpu.queue, &draws)
+        .unwrap();
+    let mut effect = StencilShadows::new(
+        &gpu.device,
+        &renderer.pass_context(),
+        &BoundaryTexture::step(1024),
+        Counting::ZFail,
+    )
+    .unwrap();
+    let albedo: Vec<Vec<Vec3>> = meshes.iter().map(|m| vec![Vec3::ONE; m.0.len()]).collect();
+    let receivers: Vec<Receiver> = meshes
+        .iter()
+        .zip(&albedo)
+        .map(|(m, a)| Receiver {
+            positions: m.0,
+            normals: &m.2,
+            albedo: a,
+            triangles: m.1,
+        })
+        .collect();
+    effect.set_receivers(&gpu.device, &receivers).unwrap();
+    let light = Light::Point(DVec3::new(1.5, 5.0, 1.0));
+    let mut volume = ShadowVolume::new();
+    let topology = CasterTopology::new(s.caster.0.len(), &s.caster.1).unwrap();
+    volume
+        .build(&topology, &s.caster.0, &light, &VolumeParams::default())
+        .unwrap();
+    effect
+        .set_lights(
+            &gpu.device,
+            &gpu.queue,
+            &[FrameLight {
+                light,
+                intensity: Vec3::splat(30.0),
+                volume: &volume,
+                boundary: None,
+            }],
+        )
+        .unwrap();
+    let camera = Camera::look_at(
+        Vec3::new(3.5, 4.0, 5.0),
+        Vec3::new(-0.5, 0.8, -0.5),
+        Vec3::Y,
+        50.0,
+        SIZE,
+        SIZE,
+    );
+    let image = renderer
+        .render(
+            &gpu.device,
+            &gpu.queue,
+            &camera,
+            Background::Color([0.0; 3]),
+            &[&effect],
+        )
+        .unwrap();
+    // The exact mask of the same view over the same triangles.
+    let mut all_positions = positions.clone();
+    let mut all_triangles = facets.clone();
+    let base = all_positions.len() as u32;
+    all_positions.extend(&s.ground.0);
+    all_triangles.extend(s.ground.1.iter().map(|t| t.map(|i| i + base)));
+    let exact = shadows::exact_view_mask(&all_positions, &all_triangles, &light, &camera).unwrap();
+    let n = SIZE as usize;
+    let (mut compared, mut lit, mut dark) = (0, 0, 0);
+    for y in 1..n - 1 {
+        for x in 1..n - 1 {
+            let e = exact[y * n + x];
+            let uniform =
+                (y - 1..=y + 1).all(|yy| (x - 1..=x + 1).all(|xx| exact[yy * n + xx] == e));
+            if e.is_nan() || !uniform {
+                continue;
+            }
+            compared += 1;
+            let gpu_shadowed = image.pixels()[y * n + x][0] <= 1e-6;
+            assert_eq!(gpu_shadowed, e == 1.0, "pixel ({x}, {y}): exact {e}");
+            if e == 1.0 { dark += 1 } else { lit += 1 }
+        }
+    }
+    eprintln!("{compared} pixels equal ({lit} lit, {dark} in shadow)");
+    assert!(lit > 1000 && dark > 300, "{lit} lit, {dark} dark");
+}
