@@ -15,8 +15,9 @@
 //!   of sun motion, with the stencil's visibility alone (n·l > 0), and through eq. 5.6's
 //!   texture at α = 0° and 15°.
 //!
-//! Writes `target/repro/shadows.md`, `shadows-lod.svg`, `shadows-zigzag.svg` and
-//! `shadows-popping.svg` (atomically).
+//! Writes `target/repro/shadows.md`, `shadows-lod.svg`, `shadows-zigzag.svg`,
+//! `shadows-popping.svg` and, with an adapter, the pictures `shadows-fig5.9.png` and
+//! `shadows-fig4.3.png` ([`pictures`]) (atomically).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -32,6 +33,8 @@ use shadows::volume::{CasterTopology, Extrusion, ShadowVolume, Sides, VolumePara
 use shadows::{GroundGrid, Light, LodTarget, MaskRenderer, caster_lod, exact_ground_mask};
 
 use crate::repro_visibility::timed;
+
+mod pictures;
 
 const BUNNY: &str = "meshes/bun_zipper.ply";
 /// Caster levels (share of the triangles) of part (a).
@@ -52,6 +55,33 @@ pub fn run(out: &Path, quick: bool) -> anyhow::Result<()> {
         None => writeln!(md, "No GPU adapter: stencil columns are empty.\n")?,
     }
     let lod_svg = lod_chain(&mut md, gpu.as_ref(), quick)?;
+    if let Some(g) = &gpu {
+        pictures::fig_5_9(g, &out.join("shadows-fig5.9.png"))?;
+        let path = test_data::data_root().join(BUNNY);
+        let (mesh, _) = meshio::load_mesh(&path, &meshio::LoadOptions::default())?;
+        let level = caster_lod(
+            &mesh.positions,
+            &mesh.triangles,
+            LodTarget::Soft,
+            shadows::lod::DEFAULT_SAMPLES,
+            0,
+        )?;
+        pictures::fig_4_3(
+            g,
+            &out.join("shadows-fig4.3.png"),
+            (&mesh.positions, &mesh.triangles),
+            (&level.triangles, level.receiver_offset()),
+        )?;
+        writeln!(
+            md,
+            "\nPictures: `shadows-fig5.9.png` (a 320-triangle sphere: the stencil's terminator alone, \
+             left, and through eq. 5.6 at α = 15°, right) and `shadows-fig4.3.png` (the bunny's shadow \
+             from the full caster, left, and from its 1 % level of {} triangles moved in by its offset \
+             {:.5}, right).\n",
+            level.triangles.len(),
+            level.receiver_offset()
+        )?;
+    }
     let zigzag_svg = zigzag(&mut md, quick)?;
     let popping_svg = popping(&mut md, quick)?;
     atomic_out::write_bytes(&out.join("shadows.md"), md.as_bytes())?;
