@@ -2,13 +2,13 @@
 //! ground mask seen by an orthographic camera from above (the `cloth-vis shadows` command).
 
 use bytemuck::{Pod, Zeroable};
-use glam::{DVec3, Mat4, Vec3};
+use glam::{Mat4, Vec3};
 use gpu_context::layout::{bind_group, bind_group_layout, binding};
 use gpu_context::{GpuContext, RenderPipelineDesc, pipeline};
 use wgpu::util::DeviceExt;
 
 use crate::volume::{CasterTopology, Extrusion, ShadowVolume, Sides, VolumeParams, VolumeStats};
-use crate::{GroundGrid, Light, ShadowError};
+use crate::{GroundGrid, Light, ShadowError, ground_extrusion};
 
 /// WGSL of the stencil passes (after the render crate's `view.wgsl`).
 pub const SHADOWS_SHADER: &str = include_str!("shadows.wgsl");
@@ -379,24 +379,6 @@ impl MaskRenderer {
             .map(|&b| f32::from(u8::from(b > 127)))
             .collect())
     }
-}
-
-/// The finite extrusion a ground mask needs: twice the diagonal of the box around the caster,
-/// the ground's extent and a point light, so every volume reaches past the plane wherever the
-/// grid can see it.
-pub fn ground_extrusion(positions: &[Vec3], grid: &GroundGrid, light: &Light) -> f64 {
-    let [x0, z0, x1, z1] = grid.extent;
-    let mut lo = DVec3::new(x0, grid.y, z0);
-    let mut hi = DVec3::new(x1, grid.y, z1);
-    for p in positions {
-        lo = lo.min(p.as_dvec3());
-        hi = hi.max(p.as_dvec3());
-    }
-    if let Light::Point(l) = light {
-        lo = lo.min(*l);
-        hi = hi.max(*l);
-    }
-    2.0 * (hi - lo).length().max(1e-9)
 }
 
 /// The stencil mask of a caster over `grid` in one call: topology, volume (finite extrusion,

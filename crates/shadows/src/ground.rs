@@ -96,6 +96,24 @@ impl GroundGrid {
     }
 }
 
+/// The finite extrusion a ground mask needs: twice the diagonal of the box around the caster,
+/// the ground's extent and a point light, so every volume reaches past the plane wherever the
+/// grid can see it.
+pub fn ground_extrusion(positions: &[Vec3], grid: &GroundGrid, light: &Light) -> f64 {
+    let [x0, z0, x1, z1] = grid.extent;
+    let mut lo = DVec3::new(x0, grid.y, z0);
+    let mut hi = DVec3::new(x1, grid.y, z1);
+    for p in positions {
+        lo = lo.min(p.as_dvec3());
+        hi = hi.max(p.as_dvec3());
+    }
+    if let Light::Point(l) = light {
+        lo = lo.min(*l);
+        hi = hi.max(*l);
+    }
+    2.0 * (hi - lo).length().max(1e-9)
+}
+
 /// The exact mask of `grid` (row-major, N × N, 1 = the cell centre's segment to the light
 /// meets a caster triangle, 0 = lit), by one ray per cell through occlusion-gpu's BVH.
 ///
@@ -113,13 +131,7 @@ pub fn exact_ground_mask(
     grid: &GroundGrid,
 ) -> Result<Vec<f32>, ShadowError> {
     let light = light.validated()?;
-    let scene = occlusion_gpu::Scene::single(
-        positions.to_vec(),
-        vec![Vec3::Y; positions.len()],
-        triangles.to_vec(),
-    )?;
-    let caster = occlusion_gpu::RayCaster::new(&scene)?;
-    let offset = f64::from(occlusion_gpu::DEFAULT_OFFSET_RELATIVE * caster.diagonal());
+    let (caster, offset) = ray_caster(positions, triangles)?;
     let n = grid.n;
     let mut mask = vec![0.0f32; n * n];
     mask.par_chunks_mut(n).enumerate().for_each(|(j, row)| {
@@ -145,4 +157,20 @@ pub fn exact_ground_mask(
         }
     });
     Ok(mask)
+}
+
+/// The BVH of a caster for exact rays (every triangle occludes, both faces), and the distance
+/// a ray starts off its surface (occlusion-gpu's relative offset times the scene's diagonal).
+pub(crate) fn ray_caster(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> Result<(occlusion_gpu::RayCaster, f64), ShadowError> {
+    let scene = occlusion_gpu::Scene::single(
+        positions.to_vec(),
+        vec![Vec3::Y; positions.len()],
+        triangles.to_vec(),
+    )?;
+    let caster = occlusion_gpu::RayCaster::new(&scene)?;
+    let offset = f64::from(occlusion_gpu::DEFAULT_OFFSET_RELATIVE * caster.diagonal());
+    Ok((caster, offset))
 }

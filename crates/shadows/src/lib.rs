@@ -67,10 +67,10 @@ pub use boundary::{BoundaryMode, BoundaryTexture, DEFAULT_ALPHA_DEG, boundary_u}
 pub use error::ShadowError;
 #[cfg(feature = "gpu")]
 pub use gpu::{
-    Counting, MaskRenderer, SHADOWS_SHADER, ground_extrusion, stencil_ground_mask,
-    stencil_test_state, volume_stencil_state,
+    Counting, MaskRenderer, SHADOWS_SHADER, stencil_ground_mask, stencil_test_state,
+    volume_stencil_state,
 };
-pub use ground::{GroundGrid, exact_ground_mask};
+pub use ground::{GroundGrid, exact_ground_mask, ground_extrusion};
 pub use light::Light;
 pub use lod::{Hausdorff, LodLevel, LodTarget, caster_lod, hausdorff, simplify};
 pub use view::exact_view_mask;

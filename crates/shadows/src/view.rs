@@ -34,13 +34,7 @@ pub fn exact_view_mask(
         crate::error::bad_parameter("camera", e.value.clone(), "must make an image")
     })?;
     let world_from_clip = clip_from_world.inverse();
-    let scene = occlusion_gpu::Scene::single(
-        positions.to_vec(),
-        vec![Vec3::Y; positions.len()],
-        triangles.to_vec(),
-    )?;
-    let caster = occlusion_gpu::RayCaster::new(&scene)?;
-    let offset = f64::from(occlusion_gpu::DEFAULT_OFFSET_RELATIVE * caster.diagonal());
+    let (caster, offset) = crate::ground::ray_caster(positions, triangles)?;
     let (w, h) = (camera.width as usize, camera.height as usize);
     let eye = camera.eye.as_dvec3();
     let mut mask = vec![f32::NAN; w * h];

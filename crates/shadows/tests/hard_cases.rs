@@ -127,25 +127,9 @@ fn open_cloth_border_edges() {
     // A wavy open sheet with folds: two-sided casting must match rays (both faces occlude);
     // one-sided casting leaks where the sheet turns its back to the light.
     let n = 30u32;
-    let mut positions = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
-            positions.push(Vec3::new(
-                1.6 * x,
-                1.0 + 0.25 * (9.0 * x).sin() * (6.0 * z).cos(),
-                1.6 * z,
-            ));
-        }
-    }
-    let mut triangles = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let v = j * (n + 1) + i;
-            triangles.push([v, v + n + 1, v + 1]);
-            triangles.push([v + 1, v + n + 1, v + n + 2]);
-        }
-    }
+    let (positions, triangles) = height_field(n, 1.6, |x, z| {
+        1.0 + 0.25 * (9.0 * x).sin() * (6.0 * z).cos()
+    });
     let topology = CasterTopology::new(positions.len(), &triangles).unwrap();
     assert_eq!(topology.border_edge_count(), 4 * n as usize);
     let light = Light::Directional(DVec3::new(0.9, 0.5, 0.1));
@@ -453,26 +437,9 @@ fn self_shadowing_from_a_coarse_caster() {
     // vertex moves along its normal, away from the light's side, by the level's backward
     // Hausdorff distance (the offset rule of `lod`; moving along the light by the same distance
     // left 6 pixels of acne on the slopes).
-    let n = 60u32;
-    let mut positions = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
-            positions.push(Vec3::new(
-                x,
-                0.8 + 0.06 * (25.0 * x).sin() * (19.0 * z).cos(),
-                z,
-            ));
-        }
-    }
-    let mut triangles = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let v = j * (n + 1) + i;
-            triangles.push([v, v + n + 1, v + 1]);
-            triangles.push([v + 1, v + n + 1, v + n + 2]);
-        }
-    }
+    let (positions, triangles) = height_field(60, 1.0, |x, z| {
+        0.8 + 0.06 * (25.0 * x).sin() * (19.0 * z).cos()
+    });
     let level = shadows::caster_lod(
         &positions,
         &triangles,

@@ -13,26 +13,7 @@ use shadows::volume::{CasterTopology, Extrusion, ShadowVolume, Sides, VolumePara
 
 /// A wavy open sheet (n × n quads) with folds, so some faces face away from the light.
 fn sheet(n: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let mut positions = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
-            positions.push(Vec3::new(
-                x,
-                1.0 + 0.3 * (7.0 * x).sin() * (5.0 * z).cos(),
-                z,
-            ));
-        }
-    }
-    let mut triangles = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let v = j * (n + 1) + i;
-            triangles.push([v, v + n + 1, v + 1]);
-            triangles.push([v + 1, v + n + 1, v + n + 2]);
-        }
-    }
-    (positions, triangles)
+    height_field(n, 1.0, |x, z| 1.0 + 0.3 * (7.0 * x).sin() * (5.0 * z).cos())
 }
 
 fn build(

@@ -12,6 +12,31 @@ pub fn sphere(centre: Vec3, radius: f32, detail: u32) -> (Vec<Vec3>, Vec<[u32; 3
     synth::obstacle_mesh(&synth::Obstacle::Sphere { centre, radius }, detail)
 }
 
+/// An open n × n grid over [−side/2, side/2]² at heights `height(x, z)` (x, z ∈ [−½, ½]), wound
+/// counter-clockwise seen from above.
+pub fn height_field(
+    n: u32,
+    side: f32,
+    height: impl Fn(f32, f32) -> f32,
+) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut positions = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
+            positions.push(Vec3::new(side * x, height(x, z), side * z));
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let v = j * (n + 1) + i;
+            triangles.push([v, v + n + 1, v + 1]);
+            triangles.push([v + 1, v + n + 1, v + n + 2]);
+        }
+    }
+    (positions, triangles)
+}
+
 /// The smallest distance from `centre` to a face plane: the polyhedron contains the ball of
 /// this radius (and is contained in the ball through its vertices).
 pub fn inscribed_radius(positions: &[Vec3], triangles: &[[u32; 3]], centre: Vec3) -> f64 {
@@ -60,7 +85,7 @@ pub fn winding_mask(
     let mut volume = ShadowVolume::new();
     let params = VolumeParams {
         sides,
-        extrusion: Extrusion::Finite(extrusion(positions, grid, light)),
+        extrusion: Extrusion::Finite(shadows::ground_extrusion(positions, grid, light)),
         origin: grid.centre(),
         ..Default::default()
     };
@@ -77,22 +102,6 @@ pub fn winding_mask(
         }
     }
     mask
-}
-
-/// As the GPU path chooses it (twice the diagonal of caster, ground and point light).
-pub fn extrusion(positions: &[Vec3], grid: &GroundGrid, light: &Light) -> f64 {
-    let [x0, z0, x1, z1] = grid.extent;
-    let mut lo = DVec3::new(x0, grid.y, z0);
-    let mut hi = DVec3::new(x1, grid.y, z1);
-    for p in positions {
-        lo = lo.min(p.as_dvec3());
-        hi = hi.max(p.as_dvec3());
-    }
-    if let Light::Point(l) = light {
-        lo = lo.min(*l);
-        hi = hi.max(*l);
-    }
-    2.0 * (hi - lo).length()
 }
 
 /// The stencil mask when an adapter exists (skipped otherwise, failing under CI).
