@@ -4,6 +4,8 @@
 //! z-pass both equal the rays here. The eye inside a volume and the near plane cutting one, where
 //! z-pass fails, are in `hard_cases.rs`.
 
+#![cfg(feature = "gpu")]
+
 mod common;
 
 use common::frame::*;

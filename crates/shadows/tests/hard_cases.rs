@@ -7,9 +7,11 @@
 
 mod common;
 
+#[cfg(feature = "gpu")]
 use common::frame::*;
 use common::*;
 use glam::{DVec3, Vec3};
+#[cfg(feature = "gpu")]
 use render::Camera;
 use shadows::volume::{CasterTopology, Extrusion, ShadowVolume, Sides, VolumeParams};
 use shadows::{GroundGrid, Light, exact_ground_mask};
@@ -54,6 +56,7 @@ fn shadowed_share(mask: &[f32]) -> f64 {
 }
 
 #[test]
+#[cfg(feature = "gpu")]
 fn eye_inside_a_volume() {
     let Light::Directional(d) = sun() else {
         unreachable!()
@@ -78,6 +81,7 @@ fn eye_inside_a_volume() {
 }
 
 #[test]
+#[cfg(feature = "gpu")]
 fn near_plane_crossing_a_volume() {
     // The eye stands just outside the volume's side with a near plane of 0.6: the plane cuts
     // the volume, which z-pass counting would get wrong.
@@ -328,6 +332,7 @@ fn cube(centre: Vec3, half: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     (positions, triangles)
 }
 
+#[cfg(feature = "gpu")]
 /// Renders `receiver` (unit albedo, no ambient) lit by `light` through the volume of
 /// `caster_triangles` (indices into the receiver's positions) moved back by `offset`; returns
 /// the red channel of each pixel and the camera.
@@ -418,6 +423,7 @@ fn render_self_shadowed(
     Some((image.pixels().iter().map(|p| p[0]).collect(), camera))
 }
 
+#[cfg(feature = "gpu")]
 fn meshio_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     let mut n = vec![Vec3::ZERO; positions.len()];
     for t in triangles {
@@ -431,6 +437,7 @@ fn meshio_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
 }
 
 #[test]
+#[cfg(feature = "gpu")]
 fn self_shadowing_from_a_coarse_caster() {
     // A height field under a light straight above cannot shadow itself. Its 10 % caster cuts
     // across the troughs, above the fine surface, and shadows it (acne) — unless each caster
