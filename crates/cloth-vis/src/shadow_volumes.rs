@@ -43,6 +43,8 @@ pub struct ShadowVolumeStage {
     volumes: Vec<ShadowVolume>,
     scratch: ShadowVolume,
     ambient: f32,
+    /// Receiver names (empty = every object and the ground).
+    receivers: Vec<String>,
     /// What the run report records of the setup (casters, levels, lights, time).
     setup: serde_json::Value,
 }
@@ -140,6 +142,7 @@ impl ShadowVolumeStage {
             boundary,
             scratch: ShadowVolume::new(),
             ambient: desc.ambient,
+            receivers: desc.receivers.clone(),
             setup,
         })
     }
@@ -187,11 +190,15 @@ impl ShadowVolumeStage {
             }
             triangles += volume.stats().triangles();
         }
-        let albedo: Vec<Vec<Vec3>> = objects
+        let receiving: Vec<&WorldObject> = objects
+            .iter()
+            .filter(|o| self.receivers.is_empty() || self.receivers.contains(&o.name))
+            .collect();
+        let albedo: Vec<Vec<Vec3>> = receiving
             .iter()
             .map(|o| vec![o.albedo; o.positions.len()])
             .collect();
-        let receivers: Vec<Receiver> = objects
+        let receivers: Vec<Receiver> = receiving
             .iter()
             .zip(&albedo)
             .map(|(o, albedo)| Receiver {

@@ -312,6 +312,10 @@ fn bad_shadow_volume_tables_are_named_before_any_work() {
             "shadow_volumes.casters",
         ),
         (
+            format!("[shadow_volumes]\nreceivers = [\"ground\"]\n{sun}{sky}"),
+            "shadow_volumes.receivers",
+        ),
+        (
             format!("[shadow_volumes]\nlod = \"2.0\"\n{sun}{sky}"),
             "shadow_volumes.lod",
         ),

@@ -3,7 +3,8 @@
 //!
 //! ```toml
 //! [shadow_volumes]
-//! casters = ["cloth", "ball"]   # default: every object; every object and the ground receive
+//! casters = ["cloth", "ball"]   # default: every object
+//! receivers = ["cloth", "ground"] # default: every object and the ground
 //! lod = "hard"                  # soft (1 %), hard (10 %), a ratio, or a Hausdorff budget "0.5%"
 //! boundary = "smooth"           # eq. 5.6 (default), "angle-linear" (the prose), or "stencil"
 //! alpha_deg = 15.0              # eq. 5.6's offset α
@@ -52,6 +53,10 @@ pub struct ShadowVolumesDesc {
     /// Objects that cast, by name; empty = every object.
     #[serde(default)]
     pub casters: Vec<String>,
+    /// Objects that receive the lights' direct term, by name (`"ground"` for the ground);
+    /// empty = every object and the ground. The others keep only what other effects give them.
+    #[serde(default)]
+    pub receivers: Vec<String>,
     /// Caster level of detail.
     pub lod: Option<String>,
     /// `smooth` (eq. 5.6), `angle-linear`, or `stencil` (no boundary texture).
@@ -83,6 +88,7 @@ impl Default for ShadowVolumesDesc {
         Self {
             lights: Vec::new(),
             casters: Vec::new(),
+            receivers: Vec::new(),
             lod: None,
             boundary: default_boundary(),
             alpha_deg: default_alpha(),
@@ -179,6 +185,15 @@ impl Scene {
                 return Err(self.invalid(
                     "shadow_volumes.casters",
                     format!("{name:?} is not an object of the scene"),
+                ));
+            }
+        }
+        for name in &t.receivers {
+            let ground = name == super::GROUND_NAME && self.ground.is_some();
+            if !ground && !self.objects.iter().any(|o| &o.name == name) {
+                return Err(self.invalid(
+                    "shadow_volumes.receivers",
+                    format!("{name:?} is neither an object of the scene nor its [ground]"),
                 ));
             }
         }
