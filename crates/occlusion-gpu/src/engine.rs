@@ -58,33 +58,43 @@ impl VisibilityParams {
     }
 }
 
+/// The device a GPU backend runs on.
 struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
-    pipelines: Option<DepthPipelines>,
-    query: Option<QueryPipelines>,
+}
+
+/// What each backend keeps between calls: the `cpu` backend's BVH of the last scene (reused
+/// while the geometry is unchanged: refinement, vertex filtering on a static mesh, an idle
+/// scene), the GPU backends' device and pipelines (built on first use).
+enum State {
+    Cpu {
+        tracer: Option<Tracer>,
+    },
+    Depth {
+        gpu: Gpu,
+        pipelines: Option<DepthPipelines>,
+    },
+    Query {
+        gpu: Gpu,
+        pipelines: Option<(DepthPipelines, QueryPipelines)>,
+    },
 }
 
 /// Computes visibility matrices with a chosen backend.
 pub struct VisibilityEngine {
-    backend: Backend,
+    state: State,
     params: VisibilityParams,
-    gpu: Option<Gpu>,
     last_rays: u64,
-    /// The `cpu` backend's BVH of the last scene, reused while the geometry is unchanged
-    /// (refinement, vertex filtering on a static mesh, an idle scene).
-    cpu_tracer: Option<Tracer>,
 }
 
 impl VisibilityEngine {
     /// The `cpu` backend.
     pub fn cpu(params: VisibilityParams) -> Self {
         Self {
-            backend: Backend::Cpu,
+            state: State::Cpu { tracer: None },
             params,
-            gpu: None,
             last_rays: 0,
-            cpu_tracer: None,
         }
     }
 
@@ -96,23 +106,35 @@ impl VisibilityEngine {
         backend: Backend,
         params: VisibilityParams,
     ) -> Self {
-        Self {
-            backend,
-            params,
-            gpu: Some(Gpu {
-                device: device.clone(),
-                queue: queue.clone(),
+        let gpu = Gpu {
+            device: device.clone(),
+            queue: queue.clone(),
+        };
+        let state = match backend {
+            Backend::Cpu => State::Cpu { tracer: None },
+            Backend::Depth => State::Depth {
+                gpu,
                 pipelines: None,
-                query: None,
-            }),
+            },
+            Backend::Query => State::Query {
+                gpu,
+                pipelines: None,
+            },
+        };
+        Self {
+            state,
+            params,
             last_rays: 0,
-            cpu_tracer: None,
         }
     }
 
     /// The backend in use.
     pub fn backend(&self) -> Backend {
-        self.backend
+        match self.state {
+            State::Cpu { .. } => Backend::Cpu,
+            State::Depth { .. } => Backend::Depth,
+            State::Query { .. } => Backend::Query,
+        }
     }
 
     /// The parameters in use.
@@ -220,7 +242,7 @@ impl VisibilityEngine {
         scene: &Scene,
         sphere: &Lightsphere,
     ) -> Result<Vec<f32>, OcclusionError> {
-        match self.backend {
+        match self.backend() {
             Backend::Cpu => Ok(self.compute(scene, sphere)?.ambient()),
             Backend::Depth | Backend::Query => {
                 let prepared = Prepared::new(scene)?;
@@ -264,9 +286,9 @@ impl VisibilityEngine {
         scene: &Scene,
         sphere: &Lightsphere,
     ) -> Result<GpuVisibility, OcclusionError> {
-        if self.backend == Backend::Cpu {
+        if self.backend() == Backend::Cpu {
             return Err(OcclusionError::NotGpuResident {
-                backend: self.backend.name(),
+                backend: Backend::Cpu.name(),
             });
         }
         let prepared = Prepared::new(scene)?;
@@ -291,42 +313,44 @@ impl VisibilityEngine {
         solid_angles: &[f64],
         first: usize,
     ) -> Result<(&Gpu, DepthRun), OcclusionError> {
-        let backend = self.backend;
         let params = self.params.depth;
-        let gpu = self.gpu.as_mut().ok_or(OcclusionError::NoDevice {
-            backend: backend.name(),
-        })?;
-        if gpu.pipelines.is_none() {
-            gpu.pipelines = Some(DepthPipelines::new(&gpu.device));
+        match &mut self.state {
+            State::Cpu { .. } => Err(OcclusionError::NoDevice {
+                backend: Backend::Cpu.name(),
+            }),
+            State::Depth { gpu, pipelines } => {
+                let depth = pipelines.get_or_insert_with(|| DepthPipelines::new(&gpu.device));
+                let run = depth.run(
+                    &gpu.device,
+                    &gpu.queue,
+                    prepared,
+                    directions,
+                    solid_angles,
+                    first,
+                    &params,
+                )?;
+                Ok((gpu, run))
+            }
+            State::Query { gpu, pipelines } => {
+                let (depth, query) = pipelines.get_or_insert_with(|| {
+                    (
+                        DepthPipelines::new(&gpu.device),
+                        QueryPipelines::new(&gpu.device),
+                    )
+                });
+                let run = query.run(
+                    depth,
+                    &gpu.device,
+                    &gpu.queue,
+                    prepared,
+                    directions,
+                    solid_angles,
+                    first,
+                    &params,
+                )?;
+                Ok((gpu, run))
+            }
         }
-        if backend == Backend::Query && gpu.query.is_none() {
-            gpu.query = Some(QueryPipelines::new(&gpu.device));
-        }
-        let gpu = &*gpu;
-        let (device, queue) = (&gpu.device, &gpu.queue);
-        let run = match (backend, &gpu.pipelines, &gpu.query) {
-            (Backend::Depth, Some(depth), _) => depth.run(
-                device,
-                queue,
-                prepared,
-                directions,
-                solid_angles,
-                first,
-                &params,
-            )?,
-            (Backend::Query, Some(depth), Some(query)) => query.run(
-                depth,
-                device,
-                queue,
-                prepared,
-                directions,
-                solid_angles,
-                first,
-                &params,
-            )?,
-            _ => unreachable!("pipelines of {} were just built", backend.name()),
-        };
-        Ok((gpu, run))
     }
 
     /// Computes the columns `first_new..k` of `matrix`.
@@ -341,19 +365,13 @@ impl VisibilityEngine {
         if first_new >= k {
             return Ok(());
         }
-        match self.backend {
-            Backend::Cpu => {
+        match &mut self.state {
+            State::Cpu { tracer: cached } => {
                 let method = self.params.cpu.method.resolve(k - first_new);
-                if !self
-                    .cpu_tracer
-                    .as_ref()
-                    .is_some_and(|t| t.fits(prepared, method))
-                {
-                    self.cpu_tracer = Some(Tracer::new(prepared, method));
+                if !cached.as_ref().is_some_and(|t| t.fits(prepared, method)) {
+                    *cached = None;
                 }
-                let Some(tracer) = &self.cpu_tracer else {
-                    unreachable!("the tracer was just built")
-                };
+                let tracer = cached.get_or_insert_with(|| Tracer::new(prepared, method));
                 let words_per_row = matrix.words_per_row();
                 let directions = matrix.directions().to_vec();
                 self.last_rays = compute_columns(
@@ -367,7 +385,7 @@ impl VisibilityEngine {
                 );
                 Ok(())
             }
-            Backend::Depth | Backend::Query => {
+            State::Depth { .. } | State::Query { .. } => {
                 let directions = matrix.directions().to_vec();
                 let solid_angles = matrix.solid_angles().to_vec();
                 let (gpu, run) = self.run_gpu(prepared, &directions, &solid_angles, first_new)?;

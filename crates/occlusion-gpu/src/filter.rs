@@ -26,6 +26,9 @@
 //! Deviation: T comes from one triangle-id pass instead of one occlusion query per triangle
 //! of U (see [`TriangleIdRenderer`] for why), with a CPU rasteriser as reference and fallback.
 
+pub(crate) mod camera;
+mod raster;
+mod triangle_set;
 pub(crate) mod visible;
 
 use std::time::{Duration, Instant};
@@ -33,9 +36,10 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use lightsphere::Lightsphere;
 
-pub use visible::{
-    Camera, TriangleIdRenderer, TriangleSet, TriangleVisibility, visible_triangles_cpu,
-};
+pub use camera::Camera;
+pub use raster::visible_triangles_cpu;
+pub use triangle_set::TriangleSet;
+pub use visible::{TriangleIdRenderer, TriangleVisibility};
 
 use crate::{OcclusionError, Scene, VisibilityEngine, VisibilityMatrix};
 
@@ -98,11 +102,7 @@ impl VertexFilter {
         if let FilterThreshold::Fraction(f) = params.threshold
             && !(0.0..=1.0).contains(&f)
         {
-            return Err(visible::invalid(
-                "filter threshold fraction",
-                f,
-                "in [0, 1]",
-            ));
+            return Err(camera::invalid("filter threshold fraction", f, "in [0, 1]"));
         }
         Ok(Self {
             unseen: TriangleSet::full(triangle_count),
@@ -320,15 +320,16 @@ impl FilteredVisibility {
                 .as_ref()
                 .is_some_and(|f| f.triangle_count() == triangles);
         if !compatible {
-            self.matrix = Some(VisibilityMatrix::zeros(
-                vec![Vec3::ZERO; rows_total],
-                sphere,
-            ));
-            self.filter = Some(VertexFilter::new(triangles, self.params)?);
+            self.matrix = None;
+            self.filter = None;
         }
-        let (Some(filter), Some(matrix)) = (self.filter.as_mut(), self.matrix.as_mut()) else {
-            unreachable!("filter and matrix were just built");
+        let filter = match &mut self.filter {
+            Some(filter) => filter,
+            empty => empty.insert(VertexFilter::new(triangles, self.params)?),
         };
+        let matrix = self
+            .matrix
+            .get_or_insert_with(|| VisibilityMatrix::zeros(vec![Vec3::ZERO; rows_total], sphere));
         if deforming || !compatible {
             filter.reset();
             self.computed = vec![false; rows_total];

@@ -27,7 +27,7 @@ use std::time::Duration;
 
 use lightsphere::{Lightsphere, MAX_LEVEL, direction_count};
 
-use crate::filter::visible::invalid;
+use crate::filter::camera::invalid;
 use crate::{OcclusionError, Scene, VisibilityEngine, VisibilityMatrix};
 
 /// Default `rise_fraction`: rise only when the finer level is predicted to take ≤ 80% of the

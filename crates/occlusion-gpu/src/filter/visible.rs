@@ -17,354 +17,15 @@
 //! pixel-centre sampling with an inclusive edge rule instead of the GPU's top-left rule, so the
 //! two may differ on triangles that only touch pixel centres with an edge.
 
-use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
+use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-use crate::scene::Prepared;
+use super::camera::{Camera, prepare};
+use super::raster::visible_triangles_cpu;
+use super::triangle_set::TriangleSet;
 use crate::{OcclusionError, Scene};
 
 const ID_SHADER: &str = include_str!("triangle_ids.wgsl");
-/// Near plane of [`Camera::look_at`] as a fraction of the eye–target distance.
-const LOOK_AT_NEAR_RELATIVE: f32 = 1e-3;
-
-/// A perspective camera: the clip space of the render target (wgpu conventions: y up, depth
-/// 0..1) from the [`Scene`]'s world space, and the target's size in pixels.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    /// Clip space from the scene's world space.
-    pub clip_from_world: Mat4,
-    /// Target width in pixels.
-    pub width: u32,
-    /// Target height in pixels.
-    pub height: u32,
-}
-
-impl Camera {
-    /// A camera from a projection-view matrix and a target size.
-    ///
-    /// # Errors
-    /// [`OcclusionError::InvalidParameter`] for a zero size or a non-finite matrix.
-    pub fn new(clip_from_world: Mat4, width: u32, height: u32) -> Result<Self, OcclusionError> {
-        if let Some(&value) = clip_from_world
-            .to_cols_array()
-            .iter()
-            .find(|c| !c.is_finite())
-        {
-            return Err(invalid(
-                "camera clip_from_world entry",
-                value.into(),
-                "finite",
-            ));
-        }
-        for (what, value) in [("camera width", width), ("camera height", height)] {
-            if value == 0 {
-                return Err(invalid(what, value.into(), "at least 1 pixel"));
-            }
-        }
-        Ok(Self {
-            clip_from_world,
-            width,
-            height,
-        })
-    }
-
-    /// A right-handed perspective camera at `eye` looking at `target` with vertical field of
-    /// view `fov_y_radians` and an infinite far plane (the near plane is 10⁻³ × the eye–target
-    /// distance).
-    ///
-    /// # Errors
-    /// As [`Camera::new`], and [`OcclusionError::InvalidParameter`] when `eye == target` or the
-    /// field of view is outside (0, π).
-    pub fn look_at(
-        eye: Vec3,
-        target: Vec3,
-        up: Vec3,
-        fov_y_radians: f32,
-        width: u32,
-        height: u32,
-    ) -> Result<Self, OcclusionError> {
-        let distance = eye.distance(target);
-        if !(distance > 0.0 && distance.is_finite()) {
-            return Err(invalid("eye–target distance", distance.into(), "positive"));
-        }
-        if !(fov_y_radians > 0.0 && fov_y_radians < std::f32::consts::PI) {
-            return Err(invalid("fov_y_radians", fov_y_radians.into(), "in (0, π)"));
-        }
-        let aspect = width.max(1) as f32 / height.max(1) as f32;
-        // wgpu clip space: y up, depth 0..1, the DirectX convention.
-        let clip_from_view = glam::camera::rh::proj::directx::perspective_infinite(
-            fov_y_radians,
-            aspect,
-            LOOK_AT_NEAR_RELATIVE * distance,
-        );
-        let view_from_world = glam::camera::rh::view::look_at_mat4(eye, target, up);
-        Self::new(clip_from_view * view_from_world, width, height)
-    }
-
-    /// Clip space from the prepared (centred) frame: world = centred + centre.
-    fn clip_from_centred(&self, center: DVec3) -> Mat4 {
-        (self.clip_from_world.as_dmat4() * DMat4::from_translation(center)).as_mat4()
-    }
-}
-
-pub(crate) fn invalid(what: &'static str, value: f64, expected: &'static str) -> OcclusionError {
-    OcclusionError::InvalidParameter {
-        what,
-        value,
-        expected,
-    }
-}
-
-/// A set of triangles (global indices over the scene's objects in order), as a bitset.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct TriangleSet {
-    len: usize,
-    words: Vec<u64>,
-}
-
-impl TriangleSet {
-    /// The empty set over `len` triangles.
-    pub fn empty(len: usize) -> Self {
-        Self {
-            len,
-            words: vec![0; len.div_ceil(64)],
-        }
-    }
-
-    /// The set of all `len` triangles.
-    pub fn full(len: usize) -> Self {
-        let mut set = Self::empty(len);
-        set.words.fill(u64::MAX);
-        set.trim();
-        set
-    }
-
-    /// The set of the given triangles.
-    ///
-    /// # Errors
-    /// [`OcclusionError::SizeMismatch`] when an index is ≥ `len`.
-    pub fn from_indices(len: usize, indices: &[u32]) -> Result<Self, OcclusionError> {
-        let mut set = Self::empty(len);
-        for &i in indices {
-            if i as usize >= len {
-                return Err(OcclusionError::SizeMismatch {
-                    what: "triangle index",
-                    given: i as usize,
-                    expected: len,
-                });
-            }
-            set.insert(i as usize);
-        }
-        Ok(set)
-    }
-
-    /// Number of triangles the set ranges over (not the number in the set: see
-    /// [`TriangleSet::count`]).
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// Whether the set ranges over no triangles at all.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
-    /// Number of triangles in the set.
-    pub fn count(&self) -> usize {
-        self.words.iter().map(|w| w.count_ones() as usize).sum()
-    }
-
-    /// Whether triangle `i` is in the set (false out of range).
-    pub fn contains(&self, i: usize) -> bool {
-        i < self.len && self.words[i / 64] >> (i % 64) & 1 == 1
-    }
-
-    /// Adds triangle `i`.
-    ///
-    /// # Panics
-    /// When `i >= len()`.
-    pub fn insert(&mut self, i: usize) {
-        assert!(i < self.len, "triangle {i} out of range {}", self.len);
-        self.words[i / 64] |= 1 << (i % 64);
-    }
-
-    /// The triangles in the set, ascending.
-    pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
-        self.words.iter().enumerate().flat_map(|(w, &word)| {
-            let mut word = word;
-            std::iter::from_fn(move || {
-                if word == 0 {
-                    return None;
-                }
-                let bit = word.trailing_zeros() as usize;
-                word &= word - 1;
-                Some(w * 64 + bit)
-            })
-        })
-    }
-
-    /// Keeps only the triangles also in `other` (same `len`).
-    pub(crate) fn intersect_with(&mut self, other: &Self) {
-        for (a, b) in self.words.iter_mut().zip(&other.words) {
-            *a &= b;
-        }
-    }
-
-    /// Removes the triangles of `other` (same `len`).
-    pub(crate) fn subtract(&mut self, other: &Self) {
-        for (a, b) in self.words.iter_mut().zip(&other.words) {
-            *a &= !b;
-        }
-    }
-
-    /// Removes every triangle.
-    pub(crate) fn clear(&mut self) {
-        self.words.fill(0);
-    }
-
-    fn trim(&mut self) {
-        let rem = self.len % 64;
-        if rem != 0
-            && let Some(last) = self.words.last_mut()
-        {
-            *last &= (1u64 << rem) - 1;
-        }
-    }
-}
-
-/// The scene in the centred frame and the camera's clip matrix for it; `None` when the scene
-/// has no triangles (nothing can be visible).
-fn prepare(scene: &Scene, camera: &Camera) -> Result<Option<(Prepared, Mat4)>, OcclusionError> {
-    Camera::new(camera.clip_from_world, camera.width, camera.height)?;
-    if scene.triangle_count() == 0 {
-        return Ok(None);
-    }
-    let prepared = Prepared::new(scene)?;
-    let clip = camera.clip_from_centred(prepared.center);
-    Ok(Some((prepared, clip)))
-}
-
-/// The triangles that cover at least one pixel centre of `camera`'s target after the depth
-/// test, rasterised on the CPU (the reference of [`TriangleIdRenderer`]; see the module docs).
-///
-/// # Errors
-/// An invalid camera ([`OcclusionError::InvalidParameter`]) or scene (as
-/// [`crate::VisibilityEngine::compute`]).
-pub fn visible_triangles_cpu(
-    scene: &Scene,
-    camera: &Camera,
-) -> Result<TriangleSet, OcclusionError> {
-    let total = scene.triangle_count();
-    let Some((prepared, clip_from_centred)) = prepare(scene, camera)? else {
-        return Ok(TriangleSet::empty(total));
-    };
-    let clip: Vec<Vec4> = prepared
-        .positions
-        .iter()
-        .map(|p| clip_from_centred * p.extend(1.0))
-        .collect();
-    let (w, h) = (camera.width as usize, camera.height as usize);
-    let mut depth = vec![1.0f32; w * h];
-    let mut ids = vec![0u32; w * h];
-    for (t, tri) in prepared.triangles.iter().enumerate() {
-        let polygon = clip_polygon(tri.map(|i| clip[i as usize]));
-        // Screen space: pixel (x, y) has its centre at (x + 0.5, y + 0.5), y down.
-        let screen: Vec<DVec3> = polygon
-            .iter()
-            .map(|c| {
-                let ndc = c.truncate().as_dvec3() / f64::from(c.w);
-                DVec3::new(
-                    (ndc.x + 1.0) * 0.5 * w as f64,
-                    (1.0 - ndc.y) * 0.5 * h as f64,
-                    ndc.z,
-                )
-            })
-            .collect();
-        for k in 1..screen.len().saturating_sub(1) {
-            raster_triangle(
-                [screen[0], screen[k], screen[k + 1]],
-                (w, h),
-                t as u32 + 1,
-                &mut depth,
-                &mut ids,
-            );
-        }
-    }
-    let mut set = TriangleSet::empty(total);
-    for &id in ids.iter().filter(|&&id| id != 0) {
-        set.insert(id as usize - 1);
-    }
-    Ok(set)
-}
-
-/// Clips a clip-space triangle to 0 ≤ z ≤ w (near and far planes; x and y are clipped by the
-/// pixel loop), returning a convex polygon (empty when fully outside).
-fn clip_polygon(triangle: [Vec4; 3]) -> Vec<Vec4> {
-    let mut polygon = triangle.to_vec();
-    let planes: [fn(Vec4) -> f32; 2] = [|c| c.z, |c| c.w - c.z];
-    for plane in planes {
-        let mut out = Vec::with_capacity(polygon.len() + 1);
-        for (i, &a) in polygon.iter().enumerate() {
-            let b = polygon[(i + 1) % polygon.len()];
-            let (da, db) = (plane(a), plane(b));
-            if da >= 0.0 {
-                out.push(a);
-            }
-            if (da >= 0.0) != (db >= 0.0) {
-                out.push(a + (b - a) * (da / (da - db)));
-            }
-        }
-        polygon = out;
-        if polygon.is_empty() {
-            break;
-        }
-    }
-    polygon
-}
-
-/// Rasterises one screen-space triangle (x, y pixels; z NDC depth) at pixel centres with an
-/// inclusive edge rule and a `Less` depth test.
-fn raster_triangle(
-    v: [DVec3; 3],
-    (w, h): (usize, usize),
-    id: u32,
-    depth: &mut [f32],
-    ids: &mut [u32],
-) {
-    let edge =
-        |a: DVec3, b: DVec3, x: f64, y: f64| (b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x);
-    let area = edge(v[0], v[1], v[2].x, v[2].y);
-    if area == 0.0 || !area.is_finite() {
-        return;
-    }
-    let lo = v[0].min(v[1]).min(v[2]);
-    let hi = v[0].max(v[1]).max(v[2]);
-    let x0 = (lo.x - 0.5).ceil().max(0.0) as usize;
-    let y0 = (lo.y - 0.5).ceil().max(0.0) as usize;
-    let x1 = ((hi.x - 0.5).floor()).min(w as f64 - 1.0);
-    let y1 = ((hi.y - 0.5).floor()).min(h as f64 - 1.0);
-    if x1 < 0.0 || y1 < 0.0 {
-        return;
-    }
-    for y in y0..=y1 as usize {
-        let py = y as f64 + 0.5;
-        for x in x0..=x1 as usize {
-            let px = x as f64 + 0.5;
-            let b0 = edge(v[1], v[2], px, py) / area;
-            let b1 = edge(v[2], v[0], px, py) / area;
-            let b2 = edge(v[0], v[1], px, py) / area;
-            if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 {
-                continue;
-            }
-            let z = (b0 * v[0].z + b1 * v[1].z + b2 * v[2].z) as f32;
-            let pixel = y * w + x;
-            if z < depth[pixel] {
-                depth[pixel] = z;
-                ids[pixel] = id;
-            }
-        }
-    }
-}
 
 /// Render target of one size: triangle ids, depth, and a buffer for the read-back copy.
 struct IdTarget {
@@ -499,10 +160,7 @@ impl TriangleIdRenderer {
                 maximum: limits.max_buffer_size,
             });
         }
-        self.ensure_target(camera.width, camera.height);
-        let Some(target) = &self.target else {
-            unreachable!("the target was just built");
-        };
+        let target = id_target(&self.device, &mut self.target, camera.width, camera.height);
         let device = &self.device;
         let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("triangle id vertices"),
@@ -593,59 +251,66 @@ impl TriangleIdRenderer {
         }
         Ok(set)
     }
+}
 
-    /// Builds the cached target of this size unless it exists.
-    fn ensure_target(&mut self, width: u32, height: u32) {
-        if self
-            .target
-            .as_ref()
-            .is_none_or(|t| t.width != width || t.height != height)
-        {
-            let size = wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            };
-            let texture = |label, format, usage| {
-                self.device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size,
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage,
-                    view_formats: &[],
-                })
-            };
-            let ids = texture(
-                "triangle ids",
-                wgpu::TextureFormat::R32Uint,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            );
-            let depth = texture(
-                "triangle id depth",
-                wgpu::TextureFormat::Depth32Float,
-                wgpu::TextureUsages::RENDER_ATTACHMENT,
-            );
-            let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-            let padded_row_bytes = (width * 4).div_ceil(align) * align;
-            let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("triangle id copy"),
-                size: u64::from(padded_row_bytes) * u64::from(height),
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            self.target = Some(IdTarget {
-                width,
-                height,
-                ids,
-                depth,
-                readback,
-                padded_row_bytes,
-            });
-        }
+/// The id target of this size, (re)allocated when the size changed.
+fn id_target<'a>(
+    device: &wgpu::Device,
+    slot: &'a mut Option<IdTarget>,
+    width: u32,
+    height: u32,
+) -> &'a IdTarget {
+    if slot
+        .as_ref()
+        .is_some_and(|t| t.width != width || t.height != height)
+    {
+        *slot = None;
     }
+    slot.get_or_insert_with(|| {
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let texture = |label, format, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let ids = texture(
+            "triangle ids",
+            wgpu::TextureFormat::R32Uint,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let depth = texture(
+            "triangle id depth",
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded_row_bytes = (width * 4).div_ceil(align) * align;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("triangle id copy"),
+            size: u64::from(padded_row_bytes) * u64::from(height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        IdTarget {
+            width,
+            height,
+            ids,
+            depth,
+            readback,
+            padded_row_bytes,
+        }
+    })
 }
 
 /// Where the visible triangles come from: the GPU id pass or the CPU rasteriser.
