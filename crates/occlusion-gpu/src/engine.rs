@@ -4,7 +4,9 @@
 use lightsphere::Lightsphere;
 
 use crate::cpu::{CpuParams, Tracer, compute_columns};
-use crate::gpu::{DepthParams, DepthPipelines, DepthRun, GpuVisibility, QueryPipelines};
+use crate::depth_params::DepthParams;
+#[cfg(feature = "gpu")]
+use crate::gpu::{DepthPipelines, DepthRun, GpuVisibility, QueryPipelines};
 use crate::scene::Prepared;
 use crate::{OcclusionError, Scene, VisibilityMatrix};
 
@@ -59,6 +61,7 @@ impl VisibilityParams {
 }
 
 /// The device a GPU backend runs on.
+#[cfg(feature = "gpu")]
 struct Gpu {
     device: wgpu::Device,
     queue: wgpu::Queue,
@@ -71,10 +74,12 @@ enum State {
     Cpu {
         tracer: Option<Tracer>,
     },
+    #[cfg(feature = "gpu")]
     Depth {
         gpu: Gpu,
         pipelines: Option<DepthPipelines>,
     },
+    #[cfg(feature = "gpu")]
     Query {
         gpu: Gpu,
         pipelines: Option<(DepthPipelines, QueryPipelines)>,
@@ -99,7 +104,8 @@ impl VisibilityEngine {
     }
 
     /// Any backend; GPU backends run on `device` and `queue` (cloned handles are kept). The
-    /// pipelines are built on first use.
+    /// pipelines are built on first use. (Feature `gpu`.)
+    #[cfg(feature = "gpu")]
     pub fn with_gpu(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -132,7 +138,9 @@ impl VisibilityEngine {
     pub fn backend(&self) -> Backend {
         match self.state {
             State::Cpu { .. } => Backend::Cpu,
+            #[cfg(feature = "gpu")]
             State::Depth { .. } => Backend::Depth,
+            #[cfg(feature = "gpu")]
             State::Query { .. } => Backend::Query,
         }
     }
@@ -242,15 +250,14 @@ impl VisibilityEngine {
         scene: &Scene,
         sphere: &Lightsphere,
     ) -> Result<Vec<f32>, OcclusionError> {
-        match self.backend() {
-            Backend::Cpu => Ok(self.compute(scene, sphere)?.ambient()),
-            Backend::Depth | Backend::Query => {
-                let prepared = Prepared::new(scene)?;
-                let (gpu, run) =
-                    self.run_gpu(&prepared, sphere.directions(), sphere.solid_angles(), 0)?;
-                run.read_ambient(&gpu.device, &gpu.queue)
-            }
+        #[cfg(feature = "gpu")]
+        if self.backend() != Backend::Cpu {
+            let prepared = Prepared::new(scene)?;
+            let (gpu, run) =
+                self.run_gpu(&prepared, sphere.directions(), sphere.solid_angles(), 0)?;
+            return run.read_ambient(&gpu.device, &gpu.queue);
         }
+        Ok(self.compute(scene, sphere)?.ambient())
     }
 
     /// Computes the full visibility matrix and a_i on the GPU and keeps them there: M stays
@@ -261,6 +268,8 @@ impl VisibilityEngine {
     /// # Errors
     /// [`OcclusionError::NotGpuResident`] on the `cpu` backend, and the errors of
     /// [`VisibilityEngine::compute`].
+    ///
+    /// Feature `gpu`.
     ///
     /// # Examples
     /// ```no_run
@@ -281,6 +290,7 @@ impl VisibilityEngine {
     /// # Ok(())
     /// # }
     /// ```
+    #[cfg(feature = "gpu")]
     pub fn compute_resident(
         &mut self,
         scene: &Scene,
@@ -306,6 +316,7 @@ impl VisibilityEngine {
 
     /// Runs the GPU backend in use for the columns `first..k` (pipelines built on first use);
     /// the results stay on the GPU.
+    #[cfg(feature = "gpu")]
     fn run_gpu(
         &mut self,
         prepared: &Prepared,
@@ -385,6 +396,7 @@ impl VisibilityEngine {
                 );
                 Ok(())
             }
+            #[cfg(feature = "gpu")]
             State::Depth { .. } | State::Query { .. } => {
                 let directions = matrix.directions().to_vec();
                 let solid_angles = matrix.solid_angles().to_vec();

@@ -29,6 +29,7 @@
 pub(crate) mod camera;
 mod raster;
 mod triangle_set;
+#[cfg(feature = "gpu")]
 pub(crate) mod visible;
 
 use std::time::{Duration, Instant};
@@ -39,7 +40,8 @@ use lightsphere::Lightsphere;
 pub use camera::Camera;
 pub use raster::visible_triangles_cpu;
 pub use triangle_set::TriangleSet;
-pub use visible::{TriangleIdRenderer, TriangleVisibility};
+#[cfg(feature = "gpu")]
+pub use visible::TriangleIdRenderer;
 
 use crate::{OcclusionError, Scene, VisibilityEngine, VisibilityMatrix};
 
@@ -398,5 +400,38 @@ impl FilteredVisibility {
     /// Rows computed so far since U was last re-initialised.
     pub fn computed_rows(&self) -> usize {
         self.computed.iter().filter(|&&c| c).count()
+    }
+}
+
+/// Where the visible triangles come from: the GPU id pass or the CPU rasteriser.
+pub enum TriangleVisibility {
+    /// The GPU id pass (`TriangleIdRenderer`) on a wgpu device (boxed: it is much larger than `Cpu`).
+    #[cfg(feature = "gpu")]
+    Gpu(Box<TriangleIdRenderer>),
+    /// [`visible_triangles_cpu`] (no adapter needed).
+    Cpu,
+}
+
+impl TriangleVisibility {
+    /// The GPU id pass on `device` (`TriangleIdRenderer::new`).
+    #[cfg(feature = "gpu")]
+    pub fn gpu(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        Self::Gpu(Box::new(TriangleIdRenderer::new(device, queue)))
+    }
+
+    /// The triangles `camera` sees in `scene`.
+    ///
+    /// # Errors
+    /// As the GPU id pass (`TriangleIdRenderer::visible_triangles`) or [`visible_triangles_cpu`].
+    pub fn visible(
+        &mut self,
+        scene: &Scene,
+        camera: &Camera,
+    ) -> Result<TriangleSet, OcclusionError> {
+        match self {
+            #[cfg(feature = "gpu")]
+            Self::Gpu(renderer) => renderer.visible_triangles(scene, camera),
+            Self::Cpu => visible_triangles_cpu(scene, camera),
+        }
     }
 }

@@ -11,6 +11,11 @@
 //! precomputation: a deforming mesh recomputes M per frame, and a finer lightsphere level
 //! reuses the columns already computed ([`VisibilityEngine::refine`], §3.4, §4.2).
 //!
+//! Feature `gpu` (default) builds the `Depth` and `Query` backends, M resident on the GPU and
+//! the triangle-id pass of vertex filtering on wgpu; without it the crate is the exact CPU
+//! engine (rays, fans, [`RayCaster`], vertex filtering with the CPU rasteriser, levels, rigid
+//! look-ups) with no GPU stack to build.
+//!
 //! Backends ([`Backend`]):
 //! * `Cpu` — exact ray casting, the accuracy reference: one shadow ray per (vertex,
 //!   direction) with n·l > 0 from the vertex pushed 1e-4 × the bounding-box diagonal along its
@@ -83,10 +88,12 @@
 //! ```
 
 mod cpu;
+mod depth_params;
 mod engine;
 mod error;
 mod fan;
 mod filter;
+#[cfg(feature = "gpu")]
 mod gpu;
 mod level;
 mod matrix;
@@ -95,19 +102,22 @@ mod rigid;
 mod scene;
 
 pub use cpu::{CpuMethod, CpuParams, DEFAULT_OFFSET_RELATIVE, FAN_MIN_COLUMNS};
+pub use depth_params::{
+    DEFAULT_BIAS_CONSTANT_TEXELS, DEFAULT_BIAS_SLOPE_TEXELS, DEFAULT_DEPTH_RESOLUTION,
+    DEFAULT_MAX_ARRAY_BYTES, DEFAULT_MAX_SLOPE, DEFAULT_NORMAL_OFFSET_TEXELS, DepthParams,
+};
 pub use engine::{Backend, VisibilityEngine, VisibilityParams};
 pub use error::OcclusionError;
 pub use fan::{FAN_GROUP, FAN_SIZE, RayFan, fan_groups};
+#[cfg(feature = "gpu")]
+pub use filter::TriangleIdRenderer;
 pub use filter::{
     Camera, DEFAULT_FILTER_THRESHOLD_FRACTION, FilterParams, FilterThreshold, FilteredVisibility,
-    FrameStats, TriangleIdRenderer, TriangleSet, TriangleVisibility, VertexFilter, triangle_rows,
+    FrameStats, TriangleSet, TriangleVisibility, VertexFilter, triangle_rows,
     visible_triangles_cpu,
 };
-pub use gpu::{
-    DEFAULT_BIAS_CONSTANT_TEXELS, DEFAULT_BIAS_SLOPE_TEXELS, DEFAULT_DEPTH_RESOLUTION,
-    DEFAULT_MAX_ARRAY_BYTES, DEFAULT_MAX_SLOPE, DEFAULT_NORMAL_OFFSET_TEXELS, DepthParams,
-    GpuVisibility,
-};
+#[cfg(feature = "gpu")]
+pub use gpu::GpuVisibility;
 pub use level::{
     DEFAULT_MAX_IDLE_LEVEL, DEFAULT_MAX_LEVEL, DEFAULT_MIN_LEVEL, DEFAULT_RISE_AFTER_FRAMES,
     DEFAULT_RISE_FRACTION, LevelChange, LevelController, LevelParams,

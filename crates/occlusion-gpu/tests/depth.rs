@@ -1,5 +1,7 @@
 //! The `depth` backend (GPU, lavapipe in CI) against the exact `cpu` backend.
 
+#![cfg(feature = "gpu")]
+
 mod common;
 
 use common::*;

@@ -7,16 +7,18 @@ mod common;
 use common::*;
 use glam::Vec3;
 use lightsphere::Lightsphere;
+#[cfg(feature = "gpu")]
+use occlusion_gpu::{Backend, DepthParams, TriangleIdRenderer};
 use occlusion_gpu::{
-    Backend, Camera, DepthParams, FilterParams, FilterThreshold, FilteredVisibility,
-    OcclusionError, Scene, SceneObject, TriangleIdRenderer, TriangleSet, TriangleVisibility,
-    VertexFilter, VisibilityEngine, VisibilityMatrix, VisibilityParams, triangle_rows,
-    visible_triangles_cpu,
+    Camera, FilterParams, FilterThreshold, FilteredVisibility, OcclusionError, Scene, SceneObject,
+    TriangleSet, TriangleVisibility, VertexFilter, VisibilityEngine, VisibilityMatrix,
+    VisibilityParams, triangle_rows, visible_triangles_cpu,
 };
 
 const SIZE: u32 = 96;
 
 /// The shared GPU-or-skip harness (fails under CI, visible skip otherwise).
+#[cfg(feature = "gpu")]
 use gpu_context::testing::gpu_or_skip as gpu;
 
 fn cpu_engine() -> VisibilityEngine {
@@ -210,6 +212,7 @@ fn bunny_orbit_is_identical_cpu_backend() {
 }
 
 #[test]
+#[cfg(feature = "gpu")]
 fn bunny_orbit_is_identical_depth_backend_gpu_ids() {
     let Some(ctx) = gpu() else { return };
     let Some(scene) = shared_scene("meshes/bun_zipper_res4.ply") else {
@@ -227,6 +230,7 @@ fn bunny_orbit_is_identical_depth_backend_gpu_ids() {
 }
 
 #[test]
+#[cfg(feature = "gpu")]
 fn gpu_ids_agree_with_cpu_rasteriser() {
     let Some(ctx) = gpu() else { return };
     let mut renderer = TriangleIdRenderer::new(&ctx.device, &ctx.queue);
@@ -429,6 +433,7 @@ mod hard_cases {
                 .all(|a| a.is_nan()),
             "nothing computed"
         );
+        #[cfg(feature = "gpu")]
         if let Some(ctx) = gpu() {
             let mut renderer = TriangleIdRenderer::new(&ctx.device, &ctx.queue);
             assert_eq!(
@@ -464,6 +469,7 @@ mod hard_cases {
         );
         let full = cpu_engine().compute(&scene, &sphere).unwrap();
         assert_visible_rows_identical(&scene, &visible, driver.matrix().unwrap(), &full);
+        #[cfg(feature = "gpu")]
         if let Some(ctx) = gpu() {
             let mut renderer = TriangleIdRenderer::new(&ctx.device, &ctx.queue);
             let gpu = renderer.visible_triangles(&scene, &camera).unwrap();
@@ -494,6 +500,7 @@ mod hard_cases {
             .frame(&scene, &Lightsphere::new(0).unwrap(), &camera, true)
             .unwrap();
         assert_eq!(stats.rows_computed, 0);
+        #[cfg(feature = "gpu")]
         if let Some(ctx) = gpu() {
             let mut renderer = TriangleIdRenderer::new(&ctx.device, &ctx.queue);
             assert_eq!(
@@ -549,6 +556,7 @@ mod hard_cases {
             ambient[4..].iter().all(|a| a.is_nan()),
             "tiny triangle's vertices not computed"
         );
+        #[cfg(feature = "gpu")]
         if let Some(ctx) = gpu() {
             let mut renderer = TriangleIdRenderer::new(&ctx.device, &ctx.queue);
             let gpu = renderer.visible_triangles(&scene, &camera).unwrap();

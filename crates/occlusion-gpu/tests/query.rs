@@ -2,6 +2,8 @@
 //! GPU, lavapipe in CI) against the exact `cpu` backend and the `depth` backend, and the
 //! GPU-resident result handle of both GPU backends.
 
+#![cfg(feature = "gpu")]
+
 mod common;
 
 use std::time::Instant;

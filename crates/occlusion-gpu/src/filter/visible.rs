@@ -21,7 +21,6 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::camera::{Camera, prepare};
-use super::raster::visible_triangles_cpu;
 use super::triangle_set::TriangleSet;
 use crate::{OcclusionError, Scene};
 
@@ -311,34 +310,4 @@ fn id_target<'a>(
             padded_row_bytes,
         }
     })
-}
-
-/// Where the visible triangles come from: the GPU id pass or the CPU rasteriser.
-pub enum TriangleVisibility {
-    /// [`TriangleIdRenderer`] on a wgpu device (boxed: it is much larger than `Cpu`).
-    Gpu(Box<TriangleIdRenderer>),
-    /// [`visible_triangles_cpu`] (no adapter needed).
-    Cpu,
-}
-
-impl TriangleVisibility {
-    /// The GPU id pass on `device` ([`TriangleIdRenderer::new`]).
-    pub fn gpu(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
-        Self::Gpu(Box::new(TriangleIdRenderer::new(device, queue)))
-    }
-
-    /// The triangles `camera` sees in `scene`.
-    ///
-    /// # Errors
-    /// As [`TriangleIdRenderer::visible_triangles`] or [`visible_triangles_cpu`].
-    pub fn visible(
-        &mut self,
-        scene: &Scene,
-        camera: &Camera,
-    ) -> Result<TriangleSet, OcclusionError> {
-        match self {
-            Self::Gpu(renderer) => renderer.visible_triangles(scene, camera),
-            Self::Cpu => visible_triangles_cpu(scene, camera),
-        }
-    }
 }
