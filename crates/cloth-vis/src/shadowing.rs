@@ -135,6 +135,7 @@ impl VisibilityStage {
             "visible_share": matrix.visible_count() as f64 / total.max(1) as f64,
             "rays": self.engine.last_ray_count(),
             "depth_resolution": self.depth_resolution,
+            "bvh": bvh_report(self.engine.last_bvh()),
         });
         Ok((Visibility { matrix, rows }, report))
     }
@@ -220,4 +221,17 @@ pub fn light_objects(
         }
     }
     Ok(vertices)
+}
+
+/// The `cpu` backend's BVH work of a frame for the run report: how the tree was obtained
+/// (reused, refitted with its SAH cost ratio, built) and its milliseconds.
+fn bvh_report(stats: occlusion_gpu::BvhStats) -> serde_json::Value {
+    use occlusion_gpu::BvhUpdate;
+    let (update, sah_ratio) = match stats.update {
+        BvhUpdate::None => ("none", None),
+        BvhUpdate::Reused => ("reused", None),
+        BvhUpdate::Refitted { sah_ratio } => ("refitted", Some(sah_ratio)),
+        BvhUpdate::Built => ("built", None),
+    };
+    json!({ "update": update, "sah_ratio": sah_ratio, "ms": stats.millis })
 }

@@ -51,6 +51,7 @@ use rayon::prelude::*;
 
 use crate::fan::{FanTracer, RayFan, fan_groups};
 use crate::matrix::WORD_BITS;
+use crate::refit::LeafOrder;
 use crate::scene::Prepared;
 
 /// Ray origin offset along the normal, relative to the scene's bounding-box diagonal: the
@@ -105,6 +106,10 @@ pub struct CpuParams {
     pub offset_relative: f32,
     /// How candidate triangles are found.
     pub method: CpuMethod,
+    /// Refit the BVH of the last scene when only its positions changed (a deforming mesh),
+    /// rebuilding once its SAH cost exceeds [`crate::REBUILD_SAH_RATIO`] × the build's; false
+    /// rebuilds every time the geometry changes.
+    pub refit: bool,
 }
 
 impl Default for CpuParams {
@@ -112,6 +117,7 @@ impl Default for CpuParams {
         Self {
             offset_relative: DEFAULT_OFFSET_RELATIVE,
             method: CpuMethod::default(),
+            refit: true,
         }
     }
 }
@@ -120,6 +126,12 @@ impl CpuParams {
     /// The same parameters with another candidate search.
     pub fn with_method(mut self, method: CpuMethod) -> Self {
         self.method = method;
+        self
+    }
+
+    /// The same parameters with refitting on or off.
+    pub fn with_refit(mut self, refit: bool) -> Self {
+        self.refit = refit;
         self
     }
 }
@@ -321,6 +333,26 @@ impl Tracer {
             && self.positions == prepared.positions
             && self.triangles == prepared.triangles
     }
+
+    /// Refits this BVH to `prepared` when only positions changed (same method, topology): the
+    /// new SAH cost relative to the build's, or `None` when it cannot be refitted (another
+    /// topology or method, or the single-ray 8-wide tree). The caller rebuilds when the ratio
+    /// exceeds [`crate::REBUILD_SAH_RATIO`].
+    pub(crate) fn refit(&mut self, prepared: &Prepared, method: CpuMethod) -> Option<f32> {
+        if self.method != method
+            || self.triangles != prepared.triangles
+            || self.positions.len() != prepared.positions.len()
+        {
+            return None;
+        }
+        let ratio = match &mut self.kind {
+            TracerKind::Packets(t) => t.refit(prepared)?,
+            TracerKind::Fans(t) => t.refit(prepared)?,
+            TracerKind::SingleRays(_) => return None,
+        };
+        self.positions.clone_from(&prepared.positions);
+        Some(ratio)
+    }
 }
 
 /// The origin of vertex i's shadow rays (none for a zero normal).
@@ -336,16 +368,41 @@ fn ray_origin(prepared: &Prepared, row: usize, offset: f32) -> Option<(Vec3A, Ve
 struct PacketTracer {
     nodes: Vec<obvhs::bvh2::node::Bvh2Node>,
     triangles: Vec<EdgeTriangle>,
+    leaves: LeafOrder,
 }
 
 impl PacketTracer {
     fn new(prepared: &Prepared) -> Self {
-        let (nodes, tris) = padded_bvh2(prepared, BvhBuildParams::medium_build(), PACKET_LEAF_SIZE);
+        let (nodes, tris, leaves) =
+            padded_bvh2(prepared, BvhBuildParams::medium_build(), PACKET_LEAF_SIZE);
         let triangles = tris
             .iter()
             .map(|t| EdgeTriangle::new([t.v0.into(), t.v1.into(), t.v2.into()]))
             .collect();
-        Self { nodes, triangles }
+        Self {
+            nodes,
+            triangles,
+            leaves,
+        }
+    }
+
+    /// Refits to `prepared`'s positions (same topology); the new SAH cost over the build's.
+    fn refit(&mut self, prepared: &Prepared) -> Option<f32> {
+        let cost = crate::refit::refit(
+            &mut self.nodes,
+            &self.leaves,
+            &prepared.positions,
+            &prepared.triangles,
+            prepared.diagonal,
+        )?;
+        for (slot, t) in self
+            .triangles
+            .iter_mut()
+            .zip(leaf_triangles(prepared, &self.leaves))
+        {
+            *slot = EdgeTriangle::new(t.map(Vec3::from));
+        }
+        Some(cost / self.leaves.build_cost.max(f32::MIN_POSITIVE))
     }
 
     /// The rays of `mask` (bit r: ray from `origins[r]` towards `direction`) that escape.
@@ -614,10 +671,10 @@ pub(crate) fn padded_bvh2(
     prepared: &Prepared,
     quality: BvhBuildParams,
     leaf_size: u32,
-) -> (Vec<obvhs::bvh2::node::Bvh2Node>, Vec<Triangle>) {
+) -> (Vec<obvhs::bvh2::node::Bvh2Node>, Vec<Triangle>, LeafOrder) {
     let tris = scene_triangles(prepared);
     if tris.is_empty() {
-        return (Vec::new(), Vec::new());
+        return (Vec::new(), Vec::new(), LeafOrder::new(&[], Vec::new()));
     }
     let mut params = quality;
     params.max_prims_per_leaf = leaf_size;
@@ -627,14 +684,23 @@ pub(crate) fn padded_bvh2(
         .iter()
         .map(|&i| tris[i as usize])
         .collect();
-    let absolute = 1e-6 * prepared.diagonal;
     let mut nodes = bvh.nodes;
     for node in &mut nodes {
-        let pad = Vec3A::splat(absolute + 1e-5 * (node.aabb.max - node.aabb.min).max_element());
-        node.aabb.min -= pad;
-        node.aabb.max += pad;
+        crate::refit::pad(&mut node.aabb, prepared.diagonal);
     }
-    (nodes, ordered)
+    let leaves = LeafOrder::new(&nodes, bvh.primitive_indices);
+    (nodes, ordered, leaves)
+}
+
+/// The triangles of `prepared` in `leaves`' order (what a refitted tree's leaves index).
+pub(crate) fn leaf_triangles(prepared: &Prepared, leaves: &LeafOrder) -> Vec<[Vec3A; 3]> {
+    leaves
+        .order
+        .iter()
+        .map(|&t| {
+            prepared.triangles[t as usize].map(|v| Vec3A::from(prepared.positions[v as usize]))
+        })
+        .collect()
 }
 
 /// The scene's triangles as `obvhs` takes them (degenerate ones included: they never hit).

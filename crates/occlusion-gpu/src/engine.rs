@@ -36,6 +36,35 @@ impl Backend {
     }
 }
 
+/// How the `cpu` backend's BVH was brought to the last scene it traced.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BvhUpdate {
+    /// Nothing traced yet, or a GPU backend.
+    None,
+    /// The geometry had not changed: the tree was reused as it was.
+    Reused,
+    /// Only positions changed: the boxes were refitted; the tree's SAH cost over its cost
+    /// when built.
+    Refitted {
+        /// SAH cost ratio, ≤ [`crate::REBUILD_SAH_RATIO`].
+        sah_ratio: f32,
+    },
+    /// Built from scratch: new topology or method, refitting off, or a refit whose tree would
+    /// cost more in traversal than a build — (SAH ratio − 1) × the expected traversal time on
+    /// a fresh tree above the last build's time — or degraded past
+    /// [`crate::REBUILD_SAH_RATIO`].
+    Built,
+}
+
+/// What the last `cpu` computation spent on its BVH.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhStats {
+    /// How the tree was obtained.
+    pub update: BvhUpdate,
+    /// Time spent on it, milliseconds.
+    pub millis: f64,
+}
+
 /// Tuning knobs of all backends.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[non_exhaustive]
@@ -73,6 +102,7 @@ struct Gpu {
 enum State {
     Cpu {
         tracer: Option<Tracer>,
+        costs: TreeCosts,
     },
     #[cfg(feature = "gpu")]
     Depth {
@@ -86,20 +116,42 @@ enum State {
     },
 }
 
+/// What the last trees cost, for the refit-or-rebuild decision: a refit costs nothing to
+/// speak of but leaves a tree whose traversal is dearer by about its SAH ratio; a build costs
+/// `build_ms`. Rebuild when (ratio − 1) × the expected traversal time exceeds `build_ms`.
+#[derive(Clone, Copy, Debug, Default)]
+struct TreeCosts {
+    /// Milliseconds of the last build.
+    build_ms: f64,
+    /// Traversal milliseconds per (row × column) on a fresh tree (a refitted tree's time
+    /// divided by its SAH ratio).
+    trace_ms_per_cell: f64,
+}
+
+const NO_BVH: BvhStats = BvhStats {
+    update: BvhUpdate::None,
+    millis: 0.0,
+};
+
 /// Computes visibility matrices with a chosen backend.
 pub struct VisibilityEngine {
     state: State,
     params: VisibilityParams,
     last_rays: u64,
+    last_bvh: BvhStats,
 }
 
 impl VisibilityEngine {
     /// The `cpu` backend.
     pub fn cpu(params: VisibilityParams) -> Self {
         Self {
-            state: State::Cpu { tracer: None },
+            state: State::Cpu {
+                tracer: None,
+                costs: TreeCosts::default(),
+            },
             params,
             last_rays: 0,
+            last_bvh: NO_BVH,
         }
     }
 
@@ -117,7 +169,10 @@ impl VisibilityEngine {
             queue: queue.clone(),
         };
         let state = match backend {
-            Backend::Cpu => State::Cpu { tracer: None },
+            Backend::Cpu => State::Cpu {
+                tracer: None,
+                costs: TreeCosts::default(),
+            },
             Backend::Depth => State::Depth {
                 gpu,
                 pipelines: None,
@@ -131,6 +186,7 @@ impl VisibilityEngine {
             state,
             params,
             last_rays: 0,
+            last_bvh: NO_BVH,
         }
     }
 
@@ -148,6 +204,12 @@ impl VisibilityEngine {
     /// The parameters in use.
     pub fn params(&self) -> &VisibilityParams {
         &self.params
+    }
+
+    /// How the last `cpu` computation obtained its BVH (reused, refitted, built) and the time
+    /// it took; [`BvhUpdate::None`] on GPU backends.
+    pub fn last_bvh(&self) -> BvhStats {
+        self.last_bvh
     }
 
     /// Rays cast by the last `cpu` computation (after n·l culling); 0 for GPU backends.
@@ -377,14 +439,43 @@ impl VisibilityEngine {
             return Ok(());
         }
         match &mut self.state {
-            State::Cpu { tracer: cached } => {
+            State::Cpu {
+                tracer: cached,
+                costs,
+            } => {
                 let method = self.params.cpu.method.resolve(k - first_new);
-                if !cached.as_ref().is_some_and(|t| t.fits(prepared, method)) {
+                let cells = (matrix.rows() * (k - first_new)) as f64;
+                let start = std::time::Instant::now();
+                let worth_keeping = |ratio: f32| {
+                    ratio <= crate::REBUILD_SAH_RATIO
+                        && (f64::from(ratio) - 1.0) * costs.trace_ms_per_cell * cells
+                            <= costs.build_ms
+                };
+                let mut update = match cached.as_mut() {
+                    Some(t) if t.fits(prepared, method) => BvhUpdate::Reused,
+                    Some(t) if self.params.cpu.refit => match t.refit(prepared, method) {
+                        Some(sah_ratio) if worth_keeping(sah_ratio) => {
+                            BvhUpdate::Refitted { sah_ratio }
+                        }
+                        _ => BvhUpdate::Built,
+                    },
+                    _ => BvhUpdate::Built,
+                };
+                if update == BvhUpdate::Built {
                     *cached = None;
                 }
-                let tracer = cached.get_or_insert_with(|| Tracer::new(prepared, method));
+                let tracer = cached.get_or_insert_with(|| {
+                    update = BvhUpdate::Built;
+                    Tracer::new(prepared, method)
+                });
+                let bvh_ms = start.elapsed().as_secs_f64() * 1e3;
+                self.last_bvh = BvhStats {
+                    update,
+                    millis: bvh_ms,
+                };
                 let words_per_row = matrix.words_per_row();
                 let directions = matrix.directions().to_vec();
+                let start = std::time::Instant::now();
                 self.last_rays = compute_columns(
                     prepared,
                     tracer,
@@ -394,6 +485,19 @@ impl VisibilityEngine {
                     matrix.bits_mut(),
                     words_per_row,
                 );
+                let per_cell = start.elapsed().as_secs_f64() * 1e3 / cells.max(1.0);
+                match update {
+                    BvhUpdate::Built => {
+                        *costs = TreeCosts {
+                            build_ms: bvh_ms,
+                            trace_ms_per_cell: per_cell,
+                        };
+                    }
+                    BvhUpdate::Refitted { sah_ratio } => {
+                        costs.trace_ms_per_cell = per_cell / f64::from(sah_ratio);
+                    }
+                    BvhUpdate::Reused | BvhUpdate::None => {}
+                }
                 Ok(())
             }
             #[cfg(feature = "gpu")]

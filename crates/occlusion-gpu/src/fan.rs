@@ -39,7 +39,8 @@ use glam::{BVec3A, BVec4A, Mat3, Vec3, Vec3A, Vec4};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::node::Bvh2Node;
 
-use crate::cpu::{EDGE_TOLERANCE, padded_bvh2};
+use crate::cpu::{EDGE_TOLERANCE, leaf_triangles, padded_bvh2};
+use crate::refit::LeafOrder;
 use crate::scene::Prepared;
 
 /// Rays per fan: one bit each of a `u64` mask.
@@ -302,17 +303,41 @@ struct FanTriangle([Vec3A; 3]);
 pub(crate) struct FanTracer {
     nodes: Vec<Bvh2Node>,
     triangles: Vec<FanTriangle>,
+    leaves: LeafOrder,
 }
 
 impl FanTracer {
     /// `quality`: obvhs's build settings (a static scene affords the slowest, best tree).
     pub(crate) fn new(prepared: &Prepared, quality: BvhBuildParams) -> Self {
-        let (nodes, tris) = padded_bvh2(prepared, quality, FAN_LEAF_SIZE);
+        let (nodes, tris, leaves) = padded_bvh2(prepared, quality, FAN_LEAF_SIZE);
         let triangles = tris
             .iter()
             .map(|t| FanTriangle([t.v0, t.v1, t.v2]))
             .collect();
-        Self { nodes, triangles }
+        Self {
+            nodes,
+            triangles,
+            leaves,
+        }
+    }
+
+    /// Refits to `prepared`'s positions (same topology); the new SAH cost over the build's.
+    pub(crate) fn refit(&mut self, prepared: &Prepared) -> Option<f32> {
+        let cost = crate::refit::refit(
+            &mut self.nodes,
+            &self.leaves,
+            &prepared.positions,
+            &prepared.triangles,
+            prepared.diagonal,
+        )?;
+        for (slot, t) in self
+            .triangles
+            .iter_mut()
+            .zip(leaf_triangles(prepared, &self.leaves))
+        {
+            *slot = FanTriangle(t);
+        }
+        Some(cost / self.leaves.build_cost.max(f32::MIN_POSITIVE))
     }
 
     /// The lanes of `mask` whose rays `origin + t·d`, 0 < t < `max_t`, meet no triangle.

@@ -16,6 +16,11 @@
 //! engine (rays, fans, [`RayCaster`], vertex filtering with the CPU rasteriser, levels, rigid
 //! look-ups) with no GPU stack to build.
 //!
+//! A deforming mesh keeps its BVH: when only positions change, the `cpu` backend refits the
+//! tree of the previous frame (O(N)) instead of building one (O(N log N)), and rebuilds once
+//! the refitted tree's SAH cost passes [`REBUILD_SAH_RATIO`] × its cost when built
+//! ([`VisibilityEngine::last_bvh`] says which happened; M is the same either way).
+//!
 //! Backends ([`Backend`]):
 //! * `Cpu` — exact ray casting, the accuracy reference: one shadow ray per (vertex,
 //!   direction) with n·l > 0 from the vertex pushed 1e-4 × the bounding-box diagonal along its
@@ -98,6 +103,7 @@ mod gpu;
 mod level;
 mod matrix;
 mod rays;
+mod refit;
 mod rigid;
 mod scene;
 
@@ -106,7 +112,7 @@ pub use depth_params::{
     DEFAULT_BIAS_CONSTANT_TEXELS, DEFAULT_BIAS_SLOPE_TEXELS, DEFAULT_DEPTH_RESOLUTION,
     DEFAULT_MAX_ARRAY_BYTES, DEFAULT_MAX_SLOPE, DEFAULT_NORMAL_OFFSET_TEXELS, DepthParams,
 };
-pub use engine::{Backend, VisibilityEngine, VisibilityParams};
+pub use engine::{Backend, BvhStats, BvhUpdate, VisibilityEngine, VisibilityParams};
 pub use error::OcclusionError;
 pub use fan::{FAN_GROUP, FAN_SIZE, RayFan, fan_groups};
 #[cfg(feature = "gpu")]
@@ -124,5 +130,6 @@ pub use level::{
 };
 pub use matrix::{VisibilityMatrix, clamp_ambient};
 pub use rays::{RayCache, RayCaster};
+pub use refit::REBUILD_SAH_RATIO;
 pub use rigid::RigidLighting;
 pub use scene::{MAX_ELEMENTS, Scene, SceneObject};
