@@ -388,21 +388,13 @@ impl PacketTracer {
 
     /// Refits to `prepared`'s positions (same topology); the new SAH cost over the build's.
     fn refit(&mut self, prepared: &Prepared) -> Option<f32> {
-        let cost = crate::refit::refit(
+        crate::refit::refit_tree(
             &mut self.nodes,
             &self.leaves,
-            &prepared.positions,
-            &prepared.triangles,
-            prepared.diagonal,
-        )?;
-        for (slot, t) in self
-            .triangles
-            .iter_mut()
-            .zip(leaf_triangles(prepared, &self.leaves))
-        {
-            *slot = EdgeTriangle::new(t.map(Vec3::from));
-        }
-        Some(cost / self.leaves.build_cost.max(f32::MIN_POSITIVE))
+            &mut self.triangles,
+            prepared,
+            |t| EdgeTriangle::new(t.map(Vec3::from)),
+        )
     }
 
     /// The rays of `mask` (bit r: ray from `origins[r]` towards `direction`) that escape.

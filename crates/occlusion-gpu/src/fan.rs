@@ -39,7 +39,7 @@ use glam::{BVec3A, BVec4A, Mat3, Vec3, Vec3A, Vec4};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::node::Bvh2Node;
 
-use crate::cpu::{EDGE_TOLERANCE, leaf_triangles, padded_bvh2};
+use crate::cpu::{EDGE_TOLERANCE, padded_bvh2};
 use crate::refit::LeafOrder;
 use crate::scene::Prepared;
 
@@ -323,21 +323,13 @@ impl FanTracer {
 
     /// Refits to `prepared`'s positions (same topology); the new SAH cost over the build's.
     pub(crate) fn refit(&mut self, prepared: &Prepared) -> Option<f32> {
-        let cost = crate::refit::refit(
+        crate::refit::refit_tree(
             &mut self.nodes,
             &self.leaves,
-            &prepared.positions,
-            &prepared.triangles,
-            prepared.diagonal,
-        )?;
-        for (slot, t) in self
-            .triangles
-            .iter_mut()
-            .zip(leaf_triangles(prepared, &self.leaves))
-        {
-            *slot = FanTriangle(t);
-        }
-        Some(cost / self.leaves.build_cost.max(f32::MIN_POSITIVE))
+            &mut self.triangles,
+            prepared,
+            FanTriangle,
+        )
     }
 
     /// The lanes of `mask` whose rays `origin + t·d`, 0 < t < `max_t`, meet no triangle.

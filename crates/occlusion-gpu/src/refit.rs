@@ -106,3 +106,29 @@ pub(crate) fn refit(
     }
     Some(sah_cost(nodes))
 }
+
+/// Refits a tree built by [`crate::cpu::padded_bvh2`] and its leaf-ordered triangle data to
+/// `prepared`'s positions (same topology): the boxes through [`refit`], each triangle remade
+/// by `make`. The new SAH cost over the build's.
+pub(crate) fn refit_tree<T>(
+    nodes: &mut [Bvh2Node],
+    leaves: &LeafOrder,
+    triangles: &mut [T],
+    prepared: &crate::scene::Prepared,
+    make: impl Fn([Vec3A; 3]) -> T,
+) -> Option<f32> {
+    let cost = refit(
+        nodes,
+        leaves,
+        &prepared.positions,
+        &prepared.triangles,
+        prepared.diagonal,
+    )?;
+    for (slot, t) in triangles
+        .iter_mut()
+        .zip(crate::cpu::leaf_triangles(prepared, leaves))
+    {
+        *slot = make(t);
+    }
+    Some(cost / leaves.build_cost.max(f32::MIN_POSITIVE))
+}
