@@ -25,7 +25,7 @@ use render::{DepthConvention, FramePass, PassContext, Phase};
 use wgpu::util::DeviceExt;
 
 use crate::Counting;
-use crate::boundary::{BoundaryMode, BoundaryTexture, boundary_coordinates};
+use crate::boundary::{BoundaryMode, BoundaryTexture, boundary_u};
 use crate::volume::ShadowVolume;
 use crate::{Light, ShadowError};
 
@@ -111,7 +111,6 @@ pub struct StencilShadows {
     boundary: wgpu::Buffer,
     receivers: Vec<GpuReceiver>,
     lights: Vec<GpuLight>,
-    scratch: Vec<f32>,
 }
 
 impl StencilShadows {
@@ -270,7 +269,6 @@ impl StencilShadows {
             boundary,
             receivers: Vec::new(),
             lights: Vec::new(),
-            scratch: Vec::new(),
         })
     }
 
@@ -415,29 +413,16 @@ impl StencilShadows {
             gpu.volume_vertices = u32::try_from(vertices.len()).unwrap_or(u32::MAX);
             for (r, buffer) in self.receivers.iter().zip(&gpu.u) {
                 let mut pairs: Vec<[f32; 2]> = vec![[1.0, 1.0]; r.positions.len()];
+                // Eq. 5.6 per vertex for the front side and the back side (normal negated).
                 if let Some(b) = l.boundary {
-                    boundary_coordinates(
-                        &r.positions,
-                        &r.normals,
-                        &light,
-                        b.alpha_deg,
-                        b.mode,
-                        &mut self.scratch,
-                    )?;
-                    for (pair, &u) in pairs.iter_mut().zip(&self.scratch) {
-                        pair[0] = u;
-                    }
-                    let flipped: Vec<Vec3> = r.normals.iter().map(|n| -*n).collect();
-                    boundary_coordinates(
-                        &r.positions,
-                        &flipped,
-                        &light,
-                        b.alpha_deg,
-                        b.mode,
-                        &mut self.scratch,
-                    )?;
-                    for (pair, &u) in pairs.iter_mut().zip(&self.scratch) {
-                        pair[1] = u;
+                    crate::boundary::check_alpha(b.alpha_deg)?;
+                    let alpha = b.alpha_deg.to_radians();
+                    for ((pair, p), n) in pairs.iter_mut().zip(&r.positions).zip(&r.normals) {
+                        let (n, l) = (n.as_dvec3(), light.to_light(p.as_dvec3()));
+                        *pair = [
+                            boundary_u(n, l, alpha, b.mode) as f32,
+                            boundary_u(-n, l, alpha, b.mode) as f32,
+                        ];
                     }
                 }
                 queue.write_buffer(buffer, 0, bytemuck::cast_slice(&pairs));
