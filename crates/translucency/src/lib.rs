@@ -46,12 +46,16 @@
 
 pub mod cube;
 mod error;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod material;
 pub mod model;
 pub mod sh;
 
 pub use cube::CubeMap;
 pub use error::TranslucencyError;
+#[cfg(feature = "gpu")]
+pub use gpu::{PassTimes, PipelineParams, TranslucencyPass, TranslucentMesh};
 pub use material::{Material, PRESETS};
 pub use model::{AccumulationFrame, Light};
 pub use sh::{Sh9, Window};

@@ -177,14 +177,18 @@ impl Sh9 {
     /// E_lm = power · Y_lm(d).
     #[must_use]
     pub fn delta(d: DVec3, power: [f64; 3]) -> Self {
-        let y = basis(d.normalize());
-        let mut out = Self::default();
-        for (k, yk) in y.iter().enumerate() {
-            for c in 0..3 {
-                out.coeffs[k][c] = yk * power[c];
+        Self {
+            coeffs: basis(d.normalize()).map(|y| power.map(|p| y * p)),
+        }
+    }
+
+    /// Add `value` × `weights` (one texel's Y_lm·Δω) to the coefficients.
+    fn accumulate(&mut self, weights: &[f64; SH_COUNT], value: [f32; 3]) {
+        for (coeff, w) in self.coeffs.iter_mut().zip(weights) {
+            for (c, v) in coeff.iter_mut().zip(value) {
+                *c += w * f64::from(v);
             }
         }
-        out
     }
 
     /// Project a lat-long environment exactly as the piecewise-constant function its texels
@@ -195,22 +199,10 @@ impl Sh9 {
     pub fn project_latlong(env: &Environment) -> Self {
         let (w, h) = (env.width(), env.height());
         let mut out = Self::default();
-        let dphi = 2.0 * PI / w as f64;
-        // The φ integrals of every column, once.
-        let columns: Vec<PhiIntegrals> = (0..w)
-            .map(|c| PhiIntegrals::new(dphi * c as f64, dphi * (c + 1) as f64))
-            .collect();
+        let columns = column_integrals(w);
         for row in 0..h {
-            let (t0, t1) = latlong::row_theta_bounds(row, h);
-            let zi = CosIntegrals::new(t1.cos(), t0.cos());
-            for (col, p) in columns.iter().enumerate() {
-                let weights = texel_integrals(&zi, p);
-                let t = env.texel(row, col);
-                for (k, wk) in weights.iter().enumerate() {
-                    for c in 0..3 {
-                        out.coeffs[k][c] += wk * f64::from(t[c]);
-                    }
-                }
+            for (col, weights) in row_weights(row, h, &columns).enumerate() {
+                out.accumulate(&weights, env.texel(row, col));
             }
         }
         out.rotated(env.world_from_env().as_dquat())
@@ -222,11 +214,7 @@ impl Sh9 {
     pub fn project_cube(cube: &CubeMap) -> Self {
         let mut out = Self::default();
         for (weights, t) in cube.projection_weights().iter().zip(cube.texels()) {
-            for (k, wk) in weights.iter().enumerate() {
-                for c in 0..3 {
-                    out.coeffs[k][c] += wk * f64::from(t[c]);
-                }
-            }
+            out.accumulate(weights, *t);
         }
         out
     }
@@ -409,21 +397,23 @@ fn texel_integrals(z: &CosIntegrals, p: &PhiIntegrals) -> [f64; SH_COUNT] {
     ]
 }
 
-/// Per-texel ∫ Y_lm dω of a lat-long map of `width` × `height` (row-major): the exact
-/// projection weights [`Sh9::project_latlong`] uses (exposed for the GPU projection and tests).
-#[must_use]
-pub fn latlong_weights(width: usize, height: usize) -> Vec<[f64; SH_COUNT]> {
+/// The φ integrals of each of `width` columns.
+fn column_integrals(width: usize) -> Vec<PhiIntegrals> {
     let dphi = 2.0 * PI / width as f64;
-    let mut out = Vec::with_capacity(width * height);
-    for row in 0..height {
-        let (t0, t1) = latlong::row_theta_bounds(row, height);
-        let zi = CosIntegrals::new(t1.cos(), t0.cos());
-        for col in 0..width {
-            let p = PhiIntegrals::new(dphi * col as f64, dphi * (col + 1) as f64);
-            out.push(texel_integrals(&zi, &p));
-        }
-    }
-    out
+    (0..width)
+        .map(|c| PhiIntegrals::new(dphi * c as f64, dphi * (c + 1) as f64))
+        .collect()
+}
+
+/// ∫ Y_lm dω of each texel of lat-long row `row` (of `height`).
+fn row_weights(
+    row: usize,
+    height: usize,
+    columns: &[PhiIntegrals],
+) -> impl Iterator<Item = [f64; SH_COUNT]> + '_ {
+    let (t0, t1) = latlong::row_theta_bounds(row, height);
+    let zi = CosIntegrals::new(t1.cos(), t0.cos());
+    columns.iter().map(move |p| texel_integrals(&zi, p))
 }
 
 /// The minimum over the sphere of a delta light's windowed response B (unit power), found on

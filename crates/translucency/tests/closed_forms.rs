@@ -62,6 +62,7 @@ fn basis_and_matrix_constants_match_the_printed_six_digits() {
 }
 
 #[test]
+#[allow(clippy::needless_range_loop)]
 fn the_basis_is_orthonormal_over_the_sphere() {
     // Exact lat-long cell integrals of products are not available, so integrate products on
     // a fine cube map with exact solid angles (second-order accurate).
