@@ -58,6 +58,7 @@ impl Effect {
                 | Effect::StaticShadowing
                 | Effect::Btf
                 | Effect::ShadowVolumes
+                | Effect::Translucency
         )
     }
 

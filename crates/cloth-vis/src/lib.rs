@@ -40,9 +40,11 @@
 
 pub mod btf_stage;
 pub mod camera;
+pub mod deform;
 pub mod demo;
 pub mod effects;
 mod error;
+mod frame_effects;
 mod image_checks;
 pub mod inputs;
 pub mod lighting;
@@ -54,6 +56,7 @@ pub mod scene;
 pub mod shadow_volumes;
 pub mod shadowing;
 pub mod static_shadowing;
+pub mod translucency_stage;
 
 pub use demo::{DEMO_SCENE, demo_scene, run_demo};
 pub use effects::Effect;

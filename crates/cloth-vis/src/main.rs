@@ -40,6 +40,12 @@ enum Command {
     /// The shadow a mesh casts on a ground plane as an [N, N] mask: z-fail shadow volumes
     /// (or exact rays), optional LOD casters (thesis §2.4.1, §4.2, §5.5.1).
     Shadows(commands::shadows::ShadowsArgs),
+    /// The SH9 irradiance of an environment map (R&H's matrix, eq. 10 of seed 004) as f32
+    /// [9, 3], with the irradiance along the six axes.
+    Sh(commands::translucency::ShArgs),
+    /// A mesh with real-time subsurface scattering by spherical harmonics (seed 004): per
+    /// frame cube map, SH projection, light distance map with a peeled layer, eq. 12.
+    Translucency(commands::translucency::TranslucencyArgs),
     /// Load a mesh or an animation and print what the loader found (counts, quirks, time).
     Inspect(commands::inspect::InspectArgs),
 }
@@ -59,6 +65,8 @@ fn main() -> ExitCode {
         Command::Visibility(args) => args.run(),
         Command::Hemicube(args) => args.run(),
         Command::Shadows(args) => args.run(),
+        Command::Sh(args) => args.run(),
+        Command::Translucency(args) => args.run(),
         Command::Inspect(args) => args.run(),
     };
     match result {

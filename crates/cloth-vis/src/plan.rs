@@ -10,6 +10,7 @@
 //! | `lighting` | `lighting` or `self-shadowing` (per-vertex radiance, with M when computed) |
 //! | `render` | always (PNG/EXR) |
 //! | `shadow-volumes` | `shadow-volumes` (per frame: caster volumes per light, stencil-masked direct light in the frame) |
+//! | `translucency` | `translucency` (per frame: cube map, SH, light distance map, eq. 12 added in the frame) |
 //! | `btf` | `btf` (a compressed BTF on the objects with UVs, beside plain texturing; its own PNG) |
 //!
 //! Later effects (self-shadowing, BTF, shadow volumes, translucency) add their own stages here
@@ -38,6 +39,8 @@ pub enum Stage {
     Lighting,
     /// Shadow volumes of the casters for every light, drawn into the frame's stencil.
     ShadowVolumes,
+    /// Seed 004's translucency passes, its eq. 12 added in the frame.
+    Translucency,
     /// Rasterise and write images.
     Render,
     /// The BTF material on the chosen objects, beside plain texture mapping (own image).
@@ -55,6 +58,7 @@ impl Stage {
             Stage::StaticVisibility => "static-visibility",
             Stage::Lighting => "lighting",
             Stage::ShadowVolumes => "shadow-volumes",
+            Stage::Translucency => "translucency",
             Stage::Render => "render",
             Stage::Btf => "btf",
         }
@@ -73,8 +77,7 @@ impl Stage {
             Effect::StaticShadowing => &[Stage::Environment, Stage::StaticVisibility],
             Effect::Btf => &[Stage::Btf],
             Effect::ShadowVolumes => &[Stage::ShadowVolumes],
-            // Not built yet: validation rejects it before planning.
-            Effect::Translucency => &[],
+            Effect::Translucency => &[Stage::Translucency],
         }
     }
 }

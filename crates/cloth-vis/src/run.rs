@@ -16,12 +16,12 @@ use render::{
 use serde_json::json;
 
 use crate::Error;
+use crate::frame_effects::FrameEffects;
 use crate::inputs::{light_directions, load_environment, load_geometry};
 use crate::object::WorldObject;
 use crate::plan::{Plan, Stage};
 use crate::report::{RunReport, StageRecord};
 use crate::scene::{BackgroundDesc, BackgroundKeyword, ExposureDesc, GROUND_NAME, Scene, ToneDesc};
-use crate::shadow_volumes::ShadowVolumeStage;
 use crate::shadowing::VisibilityStage;
 use crate::static_shadowing::StaticShadowingStage;
 
@@ -138,7 +138,13 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
     let gpu = GpuContext::new(&options.gpu)?;
     let mut timer = Timer { stages: Vec::new() };
 
-    let mut objects = timer.run(Stage::Geometry, || load_geometry(scene, options.progress))?;
+    let mut objects = timer.run(Stage::Geometry, || {
+        let (mut objects, params) = load_geometry(scene, options.progress)?;
+        if plan.contains(Stage::Translucency) {
+            crate::deform::apply(scene, &mut objects)?;
+        }
+        Ok((objects, params))
+    })?;
     if let Some(range) = frames {
         check_range(scene, &objects, range)?;
     }
@@ -183,12 +189,15 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
         render::DepthConvention::Standard
     };
     let (mut renderer, background, format) = renderer_for(scene, &gpu, environment.as_ref(), depth);
-    // Its setup time (caster levels) is reported with its first frame.
-    let mut volumes = if volumes_planned {
-        Some(ShadowVolumeStage::new(scene, &gpu, &renderer, &objects)?)
-    } else {
-        None
-    };
+    // Set-up times (caster levels) are reported with the first frame.
+    let mut effects = FrameEffects::new(
+        scene,
+        &plan,
+        &gpu,
+        &renderer,
+        &mut objects,
+        environment.as_ref(),
+    )?;
     // One engine for the whole run: GPU backends keep their pipelines across frames.
     let mut shadowing = if plan.contains(Stage::Visibility) {
         Some(VisibilityStage::new(scene, Some(&gpu))?)
@@ -224,13 +233,17 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                         Ok(((), stage.light(Some(&gpu), &mut objects, env)?))
                     })?;
                 }
-                if let Some(stage) = volumes.as_mut() {
-                    timer.run(Stage::ShadowVolumes, || {
-                        Ok(((), stage.prepare(scene, &gpu, &mut objects)?))
-                    })?;
+                for (stage, millis, params) in
+                    effects.prepare(scene, &gpu, &mut objects, &look.camera)?
+                {
+                    let stage = stage.name().to_owned();
+                    timer.stages.push(StageRecord {
+                        stage,
+                        millis,
+                        params,
+                    });
                 }
-                let passes: Vec<&dyn FramePass> =
-                    volumes.iter().map(|v| v.pass() as &dyn FramePass).collect();
+                let passes = effects.passes();
                 timer.run(Stage::Render, || {
                     let (image, params, written) =
                         render_still(scene, tmp, &gpu, &mut renderer, &objects, &look, &passes)?;
@@ -245,7 +258,7 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                     &gpu,
                     shadowing.as_mut(),
                     statics.as_ref().map(|(stage, env)| (stage, *env)),
-                    volumes.as_mut(),
+                    &mut effects,
                     &mut renderer,
                     &mut objects,
                     lights.as_ref(),
@@ -653,7 +666,7 @@ fn render_sequence(
     gpu: &GpuContext,
     mut shadowing: Option<&mut VisibilityStage>,
     statics: Option<(&StaticShadowingStage, &lightsphere::Environment)>,
-    mut volumes: Option<&mut ShadowVolumeStage>,
+    effects: &mut FrameEffects,
     renderer: &mut Renderer,
     objects: &mut [WorldObject],
     lights: Option<&Lights>,
@@ -664,9 +677,9 @@ fn render_sequence(
 ) -> Result<(HdrImage, Vec<PathBuf>), Error> {
     let bar = progress_bar(progress, range.len() as u64, "rendering frames");
     let (mut pose_t, mut vis_t, mut light_t, mut render_t, mut write_t) = Default::default();
-    let (mut static_t, mut volume_t) = (FrameTimes::default(), FrameTimes::default());
+    let mut static_t = FrameTimes::default();
     let (mut vis_params, mut light_params, mut static_params) = (json!({}), json!({}), json!({}));
-    let mut volume_params = json!({});
+    let mut effect_t: Vec<(Stage, FrameTimes, serde_json::Value)> = Vec::new();
     let mut display: Option<Display> = None;
     let mut written = Vec::new();
     let mut last = None;
@@ -697,13 +710,20 @@ fn render_sequence(
             static_params = stage.light(Some(gpu), objects, env)?;
             FrameTimes::add(&mut static_t, ms_since(t));
         }
-        if let Some(stage) = volumes.as_deref_mut() {
-            let t = Instant::now();
-            volume_params = stage.prepare(scene, gpu, objects)?;
-            FrameTimes::add(&mut volume_t, ms_since(t));
+        for (stage, millis, params) in effects.prepare(scene, gpu, objects, &look.camera)? {
+            match effect_t.iter_mut().find(|e| e.0 == stage) {
+                Some(e) => {
+                    e.1.add(millis);
+                    e.2 = params;
+                }
+                None => {
+                    let mut t = FrameTimes::default();
+                    t.add(millis);
+                    effect_t.push((stage, t, params));
+                }
+            }
         }
-        let passes: Vec<&dyn FramePass> =
-            volumes.iter().map(|v| v.pass() as &dyn FramePass).collect();
+        let passes = effects.passes();
         let t = Instant::now();
         set_gouraud_meshes(gpu, renderer, objects, &look.camera, &[])?;
         let image = renderer.render(
@@ -728,7 +748,7 @@ fn render_sequence(
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let times: [(Stage, &FrameTimes, serde_json::Value); 6] = [
+    let times: [(Stage, &FrameTimes, serde_json::Value); 5] = [
         (
             Stage::Geometry,
             &pose_t,
@@ -737,7 +757,6 @@ fn render_sequence(
         (Stage::Visibility, &vis_t, vis_params),
         (Stage::StaticVisibility, &static_t, static_params),
         (Stage::Lighting, &light_t, light_params),
-        (Stage::ShadowVolumes, &volume_t, volume_params),
         (
             Stage::Render,
             &render_t,
@@ -753,7 +772,8 @@ fn render_sequence(
             }),
         ),
     ];
-    for (stage, t, params) in times {
+    let effect_times = effect_t.iter().map(|(s, t, p)| (*s, t, p.clone()));
+    for (stage, t, params) in times.into_iter().chain(effect_times) {
         if t.frames > 0 {
             timer.stages.push(t.record(stage, params));
         }

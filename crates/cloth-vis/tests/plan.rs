@@ -3,7 +3,7 @@
 
 mod common;
 
-use cloth_vis::{Error, Plan, RunOptions, Stage, demo_scene, run_scene};
+use cloth_vis::{Plan, RunOptions, Stage, demo_scene, run_scene};
 use common::scene;
 
 const CLOTH: &str = r#"
@@ -83,28 +83,30 @@ fn bad_btf_tables_are_named_before_any_work() {
 }
 
 #[test]
-fn an_effect_not_built_yet_is_refused_before_any_work() {
+fn every_effect_is_built_and_translucency_without_a_light_is_refused_before_any_work() {
+    assert!(cloth_vis::Effect::ALL.iter().all(|e| e.is_built()));
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let text = format!(
-        "effects = [\"lighting\", \"translucency\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n"
-    );
+    let text = format!("effects = [\"translucency\"]\n{CLOTH}\n");
     let err = run_scene(&scene(&text, dir.path()), &out, &RunOptions::default()).unwrap_err();
-    assert!(
-        matches!(
-            err,
-            Error::EffectNotBuilt {
-                effect: "translucency",
-                provider: "translucency",
-                ..
-            }
-        ),
-        "{err}"
-    );
-    assert!(err.to_string().contains("\"translucency\""), "{err}");
+    assert!(err.to_string().contains("translucency.light"), "{err}");
     assert!(
         !out.exists(),
         "no output folder may be created before validation passes"
+    );
+    // An environment light needs the scene's lighting.
+    let text = format!(
+        "effects = [\"translucency\"]\n{CLOTH}\n[translucency]\nlight = {{ environment = true }}\n"
+    );
+    let err = Plan::for_scene(&scene(&text, dir.path())).unwrap_err();
+    assert!(err.to_string().contains("self-shadowing"), "{err}");
+    let text = format!(
+        "effects = [\"translucency\"]\n{CLOTH}\n[translucency]\nmaterial = \"jade\"\nlight = {{ direction = [0, 1, 0] }}\n"
+    );
+    let err = Plan::for_scene(&scene(&text, dir.path())).unwrap_err();
+    assert!(
+        err.to_string().contains("translucency.material") && err.to_string().contains("jade"),
+        "{err}"
     );
 }
 

@@ -884,7 +884,8 @@ impl TranslucencyPass {
             ] {
                 pass.set_pipeline(pipe);
                 pass.set_bind_group(0, group, &[]);
-                pass.dispatch_workgroups(size.div_ceil(8), (6 * size).div_ceil(8), 1);
+                // Only the face slots in use (one for a directional light).
+                pass.dispatch_workgroups(size.div_ceil(8), (faces * size).div_ceil(8), 1);
             }
         }
         step(device, &mut times.blur, encoder)?;

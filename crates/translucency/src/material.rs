@@ -152,4 +152,23 @@ impl Material {
         let t = self.sigma_t_prime();
         std::array::from_fn(|c| (3.0 * self.sigma_a[c] * t[c]).sqrt())
     }
+
+    /// The dipole's total diffuse reflectance R_d (Jensen et al. 2001, eq. for R_d with
+    /// F_dr = −1.440/η² + 0.710/η + 0.668 + 0.0636 η, A = (1 + F_dr)/(1 − F_dr),
+    /// α′ = σ′_s/σ′_t): R_d = (α′/2)(1 + e^{−(4/3) A √(3(1 − α′))}) e^{−√(3(1 − α′))}. It is
+    /// the colour the material has under diffuse light, the albedo of its direct term in the
+    /// frame; 1 for a non-absorbing material (spectralon), and marble's (0.83, 0.79, 0.75) is
+    /// Jensen et al.'s table.
+    #[must_use]
+    pub fn diffuse_reflectance(&self) -> [f64; 3] {
+        let eta = self.eta;
+        let f_dr = -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta;
+        let a = (1.0 + f_dr) / (1.0 - f_dr);
+        let t = self.sigma_t_prime();
+        std::array::from_fn(|c| {
+            let alpha = self.sigma_s_prime[c] / t[c];
+            let root = (3.0 * (1.0 - alpha)).max(0.0).sqrt();
+            alpha / 2.0 * (1.0 + (-4.0 / 3.0 * a * root).exp()) * (-root).exp()
+        })
+    }
 }

@@ -341,3 +341,22 @@ fn presets_are_jensens_table_with_the_dipole_coefficients() {
     assert!(Material::new([0.0; 3], [0.0, 1.0, 1.0], 1.3).is_err());
     assert!(Material::new([0.1; 3], [1.0; 3], f64::NAN).is_err());
 }
+
+#[test]
+fn dipole_diffuse_reflectance_matches_jensens_table() {
+    // Spectralon does not absorb: R_d = 1.
+    let r = Material::preset("spectralon")
+        .unwrap()
+        .diffuse_reflectance();
+    assert!(r.iter().all(|v| (v - 1.0).abs() < 1e-12), "{r:?}");
+    // Marble (η = 1.5): Jensen et al. 2001's table prints R_d = 0.83, 0.79, 0.75.
+    let r = Material::preset("marble").unwrap().diffuse_reflectance();
+    for (got, want) in r.iter().zip([0.83, 0.79, 0.75]) {
+        assert!((got - want).abs() < 0.006, "marble R_d {r:?}");
+    }
+    // Strong absorption makes it dark.
+    let ink = Material::new([10.0; 3], [0.1; 3], 1.3)
+        .unwrap()
+        .diffuse_reflectance();
+    assert!(ink[0] < 0.01);
+}

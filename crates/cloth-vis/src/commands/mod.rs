@@ -14,6 +14,7 @@ pub mod jumpmap;
 pub mod parse;
 pub mod render;
 pub mod shadows;
+pub mod translucency;
 pub mod visibility;
 
 #[cfg(test)]

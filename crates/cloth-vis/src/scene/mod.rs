@@ -39,6 +39,7 @@ mod btf_table;
 mod output;
 mod shadow_table;
 mod static_table;
+mod translucency_table;
 
 pub use btf_table::BtfDesc;
 pub use output::{
@@ -46,6 +47,7 @@ pub use output::{
 };
 pub use shadow_table::{ShadowLightDesc, ShadowVolumesDesc};
 pub use static_table::{StaticBuilderDesc, StaticShadowingDesc};
+pub use translucency_table::{SineDeformDesc, TranslucencyDesc, TranslucencyLightDesc};
 
 /// Prefix of procedural sources in scene files.
 pub const SYNTH_PREFIX: &str = "synth:";
@@ -102,6 +104,9 @@ pub struct Scene {
     /// Hard shadows (the `shadow-volumes` effect).
     #[serde(default)]
     pub shadow_volumes: ShadowVolumesDesc,
+    /// Subsurface appearance (the `translucency` effect).
+    #[serde(default)]
+    pub translucency: TranslucencyDesc,
     /// Folder that relative paths are resolved against (the scene file's folder).
     #[serde(skip)]
     pub base_dir: PathBuf,
@@ -601,6 +606,9 @@ impl Scene {
         }
         if effects.contains(&Effect::ShadowVolumes) {
             self.validate_shadow_volumes()?;
+        }
+        if effects.contains(&Effect::Translucency) {
+            self.validate_translucency(&effects)?;
         }
         let lit = effects.iter().find(|e| {
             matches!(

@@ -10,5 +10,6 @@ mod hemicube_cmd;
 mod inspect_cmd;
 mod render_outputs;
 mod shadows_cmd;
+mod translucency_cmd;
 mod visibility_cmd;
 mod visibility_outputs;

@@ -1,0 +1,96 @@
+//! The effects that draw into the shared frame beside the Gouraud meshes — shadow volumes and
+//! translucency — built once per run and prepared every frame, in stage order.
+
+use gpu_context::GpuContext;
+use render::{Camera, FramePass, Renderer};
+
+use crate::Error;
+use crate::object::WorldObject;
+use crate::plan::{Plan, Stage};
+use crate::scene::Scene;
+use crate::shadow_volumes::ShadowVolumeStage;
+use crate::translucency_stage::TranslucencyStage;
+
+/// The frame effects a plan asks for.
+pub(crate) struct FrameEffects {
+    volumes: Option<ShadowVolumeStage>,
+    translucency: Option<TranslucencyStage>,
+}
+
+impl FrameEffects {
+    /// Build the planned effects against `renderer`'s frame.
+    ///
+    /// # Errors
+    /// Each stage's set-up errors.
+    pub fn new(
+        scene: &Scene,
+        plan: &Plan,
+        gpu: &GpuContext,
+        renderer: &Renderer,
+        objects: &mut [WorldObject],
+        environment: Option<&lightsphere::Environment>,
+    ) -> Result<Self, Error> {
+        let volumes = if plan.contains(Stage::ShadowVolumes) {
+            Some(ShadowVolumeStage::new(scene, gpu, renderer, objects)?)
+        } else {
+            None
+        };
+        let translucency = if plan.contains(Stage::Translucency) {
+            Some(TranslucencyStage::new(
+                scene,
+                gpu,
+                renderer,
+                objects,
+                environment,
+            )?)
+        } else {
+            None
+        };
+        Ok(Self {
+            volumes,
+            translucency,
+        })
+    }
+
+    /// Prepare this frame (after posing and lighting): each planned effect's stage, its
+    /// milliseconds and report parameters.
+    ///
+    /// # Errors
+    /// Each stage's errors.
+    pub fn prepare(
+        &mut self,
+        scene: &Scene,
+        gpu: &GpuContext,
+        objects: &mut [WorldObject],
+        camera: &Camera,
+    ) -> Result<Vec<(Stage, f64, serde_json::Value)>, Error> {
+        let mut done = Vec::new();
+        if let Some(stage) = self.volumes.as_mut() {
+            let t = std::time::Instant::now();
+            let params = stage.prepare(scene, gpu, objects)?;
+            done.push((
+                Stage::ShadowVolumes,
+                t.elapsed().as_secs_f64() * 1e3,
+                params,
+            ));
+        }
+        if let Some(stage) = self.translucency.as_mut() {
+            let t = std::time::Instant::now();
+            let params = stage.prepare(scene, gpu, objects, camera.eye)?;
+            done.push((Stage::Translucency, t.elapsed().as_secs_f64() * 1e3, params));
+        }
+        Ok(done)
+    }
+
+    /// The passes to hand to the frame.
+    pub fn passes(&self) -> Vec<&dyn FramePass> {
+        let mut passes: Vec<&dyn FramePass> = Vec::new();
+        if let Some(v) = &self.volumes {
+            passes.push(v.pass());
+        }
+        if let Some(t) = &self.translucency {
+            passes.push(t.pass());
+        }
+        passes
+    }
+}
