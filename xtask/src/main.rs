@@ -31,8 +31,12 @@
 //!   `shadows-lod.svg`, `shadows-zigzag.svg`, `shadows-popping.svg`).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
+//! - `cargo xtask compare translucency [--quick]`: seed 004's translucency model against
+//!   Mitsuba 3's volumetric path tracer on the bunny and the dragon (image error and SSIM
+//!   beside plain diffuse shading's; Mitsuba in a virtual environment).
 
 mod compare_clustering;
+mod compare_translucency;
 mod repro_anim_compression;
 mod repro_btf;
 mod repro_hemicube;
@@ -73,6 +77,12 @@ enum Compare {
     /// PCA, k-means and local PCA against scikit-learn (time and quality).
     Clustering {
         /// One seed instead of five.
+        #[arg(long)]
+        quick: bool,
+    },
+    /// Seed 004's translucency against Mitsuba 3's volumetric path tracer (image error, SSIM).
+    Translucency {
+        /// The small bunny at 96², 32 samples per pixel.
         #[arg(long)]
         quick: bool,
     },
@@ -174,6 +184,12 @@ fn main() -> anyhow::Result<()> {
         } => {
             let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
             compare_clustering::run_comparison(&root, quick)
+        }
+        Command::Compare {
+            what: Compare::Translucency { quick },
+        } => {
+            let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+            compare_translucency::run_comparison(&root, quick)
         }
     }
 }

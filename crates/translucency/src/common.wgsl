@@ -15,7 +15,7 @@ struct Params {
     misc: vec4<f32>,
     // x: cube face size; y: light map size; z: orthographic radius; w: 1 = the peeled test on.
     maps: vec4<f32>,
-    // Window factors h0, h1, h2 (SH bands).
+    // Window factors h0, h1, h2 (SH bands); w: the attenuation's clamp distance (mm).
     window: vec4<f32>,
     // Per light-map face: forward, right, up.
     light_faces: array<vec4<f32>, 18>,

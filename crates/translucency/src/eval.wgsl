@@ -135,10 +135,11 @@ fn fs_eval(in: EvalOut, @builtin(front_facing) front_facing: bool) -> @location(
     if first < EMPTY {
         d = max(dist - first, 0.0);
     }
-    // eq. 12's attenuation, clamped at one mean free path (model.rs: attenuation_clamped).
+    // eq. 12's attenuation, clamped at the longest transport mean free path, the same for
+    // every channel (model.rs: attenuation_clamped).
     let st = params.sigma_t.xyz;
     let sr = params.sigma_tr.xyz;
-    let dm = max(vec3<f32>(d * params.sigma_tr.w), 1.0 / st);
+    let dm = vec3<f32>(max(d * params.sigma_tr.w, params.window.w));
     let atten = (sr * dm + 1.0) * exp(-sr * dm) / (st * dm * dm * dm);
     // Schlick's F_t(η, n·ω_out).
     let r0 = ((eta - 1.0) / (eta + 1.0)) * ((eta - 1.0) / (eta + 1.0));

@@ -795,7 +795,12 @@ impl TranslucencyPass {
                 radius as f32,
                 if self.params.peel { 1.0 } else { 0.0 },
             ],
-            window: [h[0] as f32, h[1] as f32, h[2] as f32, 0.0],
+            window: [
+                h[0] as f32,
+                h[1] as f32,
+                h[2] as f32,
+                material.clamp_distance() as f32,
+            ],
             light_faces: faces,
         };
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&uniform));

@@ -146,6 +146,17 @@ impl Material {
         std::array::from_fn(|c| self.sigma_a[c] + self.sigma_s_prime[c])
     }
 
+    /// The distance (mm) below which eq. 12's attenuation is clamped: 1 / min σ′_t, one
+    /// transport mean free path of the most weakly scattering channel
+    /// ([`crate::model::attenuation_clamped`]).
+    #[must_use]
+    pub fn clamp_distance(&self) -> f64 {
+        1.0 / self
+            .sigma_t_prime()
+            .into_iter()
+            .fold(f64::INFINITY, f64::min)
+    }
+
     /// Effective extinction σ_tr = √(3 σ_a σ′_t) (mm⁻¹).
     #[must_use]
     pub fn sigma_tr(&self) -> [f64; 3] {

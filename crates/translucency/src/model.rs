@@ -76,13 +76,16 @@ pub fn attenuation(sigma_tr: f64, sigma_t_prime: f64, d: f64) -> f64 {
     (sigma_tr * d + 1.0) * (-sigma_tr * d).exp() / (sigma_t_prime * d * d * d)
 }
 
-/// The clamp of A near d → 0: A is evaluated at max(d, 1/σ′_t), one transport mean free path
-/// — below it the dipole's point-source picture has no meaning, and A(1/σ′_t) =
-/// (σ_tr/σ′_t + 1) e^{−σ_tr/σ′_t} σ′_t² is finite. Silhouettes and the lit side (d ≈ 0)
-/// get this ceiling rather than infinity.
+/// The clamp of A near d → 0: A is evaluated at max(d, d_min), where it is finite. The
+/// material's clamp distance ([`Material::clamp_distance`]) is one transport mean free path
+/// of the most weakly scattering channel, 1 / min σ′_t, the same for R, G and B: below it the
+/// dipole's point-source picture has no meaning. A per-channel clamp at 1/σ′_t would give
+/// A(d_min) = (σ_tr/σ′_t + 1) e^{−σ_tr/σ′_t} σ′_t², largest where σ′_t is — silhouettes and the
+/// lit side would turn blue for every measured material, the opposite of the red that
+/// scatters furthest.
 #[must_use]
-pub fn attenuation_clamped(sigma_tr: f64, sigma_t_prime: f64, d: f64) -> f64 {
-    attenuation(sigma_tr, sigma_t_prime, d.max(1.0 / sigma_t_prime))
+pub fn attenuation_clamped(sigma_tr: f64, sigma_t_prime: f64, d: f64, d_min: f64) -> f64 {
+    attenuation(sigma_tr, sigma_t_prime, d.max(d_min))
 }
 
 /// GLSL's `refract(i, n, eta)`: the refraction of unit `incident` at unit normal `n` (facing
@@ -207,7 +210,8 @@ pub fn scattered_radiance(
     let ft = schlick_transmittance(material.eta, n.dot(omega_out));
     let (tr, tp) = (material.sigma_tr(), material.sigma_t_prime());
     let d_mm = d.max(0.0) * material.mm_per_unit;
-    std::array::from_fn(|c| ft / PI * attenuation_clamped(tr[c], tp[c], d_mm) * b[c])
+    let d_min = material.clamp_distance();
+    std::array::from_fn(|c| ft / PI * attenuation_clamped(tr[c], tp[c], d_mm, d_min) * b[c])
 }
 
 /// The lit object's transmitted irradiance at each vertex under a point or directional light

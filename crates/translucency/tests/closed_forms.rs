@@ -282,13 +282,16 @@ fn schlick_and_attenuation_match_the_oracles() {
             "A({d}) = {a}"
         );
     }
-    // The clamp: at and below one mean free path, the value at 1/σ′_t.
+    // The clamp: at and below d_min, the value at d_min; one distance for all channels,
+    // the longest mean free path.
+    let skin = Material::preset("skin1").unwrap();
+    assert!((skin.clamp_distance() - 1.0 / 0.772).abs() < 1e-12);
     assert_eq!(
-        attenuation_clamped(1.0, 2.0, 0.0),
+        attenuation_clamped(1.0, 2.0, 0.0, 0.5),
         attenuation(1.0, 2.0, 0.5)
     );
     assert_eq!(
-        attenuation_clamped(1.0, 2.0, 3.0),
+        attenuation_clamped(1.0, 2.0, 3.0, 0.5),
         attenuation(1.0, 2.0, 3.0)
     );
 }

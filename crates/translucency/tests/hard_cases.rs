@@ -264,8 +264,12 @@ mod gpu {
         let m = Material::preset("skimmilk").unwrap();
         let ceiling = (0..3)
             .map(|c| {
-                model::attenuation_clamped(m.sigma_tr()[c], m.sigma_t_prime()[c], 0.0)
-                    / std::f64::consts::PI
+                model::attenuation_clamped(
+                    m.sigma_tr()[c],
+                    m.sigma_t_prime()[c],
+                    0.0,
+                    m.clamp_distance(),
+                ) / std::f64::consts::PI
                     * 4.0
             })
             .fold(0.0, f64::max);

@@ -1,0 +1,62 @@
+//! `cargo xtask compare translucency`: seed 004's model (the `translucency` effect) against
+//! Mitsuba 3's volumetric path tracer on the bunny and the dragon of `../shared/data` — the
+//! same camera, point light and medium (skin1) — with plain diffuse shading's error beside it.
+//!
+//! Mitsuba is a comparison, not a dependency: it is installed with numpy and Pillow into a
+//! virtual environment under `target/mitsuba-venv` on first use. The script
+//! (`xtask/scripts/mitsuba_translucency.py`) writes the scenes, runs the release `cloth-vis`
+//! binary and Mitsuba, prints the table and writes the pictures to
+//! `target/translucency-compare/`. `--quick` (CI) renders the 1,000-triangle bunny at 96²
+//! with 32 samples per pixel.
+
+use std::path::Path;
+use std::process::Command;
+
+use anyhow::{Context, bail};
+
+fn run(cmd: &mut Command) -> anyhow::Result<()> {
+    let status = cmd
+        .status()
+        .with_context(|| format!("cannot start {cmd:?}"))?;
+    if !status.success() {
+        bail!("{cmd:?} failed with {status}");
+    }
+    Ok(())
+}
+
+/// Run the comparison.
+pub fn run_comparison(root: &Path, quick: bool) -> anyhow::Result<()> {
+    let data = root.join("../shared/data");
+    if !data.join("meshes/bun_zipper.ply").is_file() {
+        bail!(
+            "{} holds no meshes/bun_zipper.ply: the comparison renders the shared data",
+            data.display()
+        );
+    }
+    let venv = root.join("target/mitsuba-venv");
+    let python = venv.join("bin/python");
+    if !python.exists() {
+        run(Command::new("python3").args(["-m", "venv"]).arg(&venv))?;
+        run(Command::new(venv.join("bin/pip")).args([
+            "install",
+            "--quiet",
+            "mitsuba==3.*",
+            "numpy",
+            "pillow",
+        ]))?;
+    }
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    run(Command::new(&cargo)
+        .current_dir(root)
+        .args(["build", "--release", "-p", "cloth-vis"]))?;
+    let mut script = Command::new(&python);
+    script
+        .arg(root.join("xtask/scripts/mitsuba_translucency.py"))
+        .arg(root.join("target/release/cloth-vis"))
+        .arg(root.join("target/translucency-compare"))
+        .arg(&data);
+    if quick {
+        script.arg("--quick");
+    }
+    run(&mut script)
+}
