@@ -29,6 +29,9 @@
 //!   speed-up beside the thesis's), the zig-zag of the stencil's terminator against eq. 5.6's
 //!   on spheres and cylinders, popping under sun motion on the drape (`target/repro/shadows.md`,
 //!   `shadows-lod.svg`, `shadows-zigzag.svg`, `shadows-popping.svg`).
+//! - `cargo xtask repro translucency [--quick]`: seed 004's Table 1 (per-pass times on the
+//!   bunny and the dragon, static and under the sine deformer, beside the paper's fps), the
+//!   cube-map size against E_lm (TR 164), SH ringing per window (`target/repro/translucency.md`).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 //! - `cargo xtask compare translucency [--quick]`: seed 004's translucency model against
@@ -44,6 +47,7 @@ mod repro_jumpmap;
 mod repro_lightsphere;
 mod repro_rd_search;
 mod repro_shadows;
+mod repro_translucency;
 mod repro_visibility;
 mod sequences;
 
@@ -137,6 +141,13 @@ enum Repro {
         #[arg(long)]
         quick: bool,
     },
+    /// Translucency by SH (seed 004): Table 1's per-pass times on the bunny and the dragon,
+    /// static and deformed, the cube-map size against E_lm, SH ringing under each window.
+    Translucency {
+        /// Four frames per model instead of twenty.
+        #[arg(long)]
+        quick: bool,
+    },
     /// Static visibility maps (thesis §4.3): Table 4.1 rebuilt on the shared dress, convergence
     /// of HC/SP/HS against an HC 256² reference, the lightsphere's a_i beside it, bytes per
     /// vertex.
@@ -179,6 +190,9 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Shadows { quick },
         } => repro_shadows::run(&repro_dir()?, quick),
+        Command::Repro {
+            what: Repro::Translucency { quick },
+        } => repro_translucency::run(&repro_dir()?, quick),
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {

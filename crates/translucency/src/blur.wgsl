@@ -5,7 +5,12 @@
 // distance, and a vertical pass never crosses into the next face.
 @group(0) @binding(0) var blur_src: texture_2d<f32>;
 @group(0) @binding(1) var blur_dst: texture_storage_2d<r32float, write>;
-@group(0) @binding(2) var<uniform> blur: vec4<f32>;
+// x: face size; then the faces in use, one per workgroup z (y, z, w and the rest in `more`).
+struct Blur {
+    size: vec4<f32>,
+    faces: array<vec4<u32>, 2>,
+};
+@group(0) @binding(2) var<uniform> blur: Blur;
 
 const EMPTY: f32 = 1e29;
 // 9 taps, σ = 2 texels (the seed's "8×8" kernel has no centre; SEED-NOTES §5.7.9).
@@ -13,7 +18,7 @@ const TAPS = array<f32, 5>(0.2270270, 0.1945946, 0.1216216, 0.0540540, 0.0162162
 
 fn blur_at(p: vec2<i32>, step: vec2<i32>) -> f32 {
     let size = vec2<i32>(textureDimensions(blur_src));
-    let face_size = i32(blur.x);
+    let face_size = i32(blur.size.x);
     let centre = textureLoad(blur_src, p, 0).x;
     if centre >= EMPTY {
         return centre;
@@ -39,20 +44,22 @@ fn blur_at(p: vec2<i32>, step: vec2<i32>) -> f32 {
 
 @compute @workgroup_size(8, 8)
 fn blur_h(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(blur_src);
-    if id.x >= size.x || id.y >= size.y {
+    let face_size = u32(blur.size.x);
+    if id.x >= face_size || id.y >= face_size {
         return;
     }
-    let p = vec2<i32>(id.xy);
+    let face = blur.faces[id.z / 4u][id.z % 4u];
+    let p = vec2<i32>(vec2<u32>(id.x, id.y + face * face_size));
     textureStore(blur_dst, p, vec4<f32>(blur_at(p, vec2<i32>(1, 0)), 0.0, 0.0, 0.0));
 }
 
 @compute @workgroup_size(8, 8)
 fn blur_v(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(blur_src);
-    if id.x >= size.x || id.y >= size.y {
+    let face_size = u32(blur.size.x);
+    if id.x >= face_size || id.y >= face_size {
         return;
     }
-    let p = vec2<i32>(id.xy);
+    let face = blur.faces[id.z / 4u][id.z % 4u];
+    let p = vec2<i32>(vec2<u32>(id.x, id.y + face * face_size));
     textureStore(blur_dst, p, vec4<f32>(blur_at(p, vec2<i32>(0, 1)), 0.0, 0.0, 0.0));
 }

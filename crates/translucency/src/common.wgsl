@@ -17,7 +17,8 @@ struct Params {
     maps: vec4<f32>,
     // Window factors h0, h1, h2 (SH bands); w: the attenuation's clamp distance (mm).
     window: vec4<f32>,
-    // Per light-map face: forward, right, up.
+    // Per light-map face: forward, right, up; the w of entry 3i + 1 is the face instance i
+    // draws.
     light_faces: array<vec4<f32>, 18>,
 };
 

@@ -146,6 +146,13 @@ struct Vertex {
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
+struct BlurUniform {
+    size: [f32; 4],
+    faces: [[u32; 4]; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
 struct ParamsUniform {
     half_extent: [f32; 4],
     light: [f32; 4],
@@ -234,9 +241,11 @@ pub struct TranslucencyPass {
     window_buffer: wgpu::Buffer,
     coefficients: wgpu::Buffer,
     sh_final_group: wgpu::BindGroup,
+    blur_uniform: wgpu::Buffer,
     targets: Targets,
     mesh: Option<MeshBuffers>,
-    light_faces: u32,
+    /// The light-map faces drawn this frame (slots of the stacked textures).
+    light_faces: Vec<u32>,
 }
 
 impl TranslucencyPass {
@@ -464,10 +473,11 @@ impl TranslucencyPass {
                 coefficients.as_entire_binding(),
             ],
         );
-        let blur_size = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("translucency blur face size"),
-            contents: bytemuck::cast_slice(&[params.light_map_size as f32, 0.0, 0.0, 0.0]),
-            usage: wgpu::BufferUsages::UNIFORM,
+        let blur_size = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("translucency blur faces"),
+            size: std::mem::size_of::<BlurUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         });
 
         // Textures and the groups reading them.
@@ -605,6 +615,7 @@ impl TranslucencyPass {
             window_buffer,
             coefficients,
             sh_final_group,
+            blur_uniform: blur_size,
             targets: Targets {
                 cube,
                 cube_depth,
@@ -619,7 +630,7 @@ impl TranslucencyPass {
                 eval_group,
             },
             mesh: None,
-            light_faces: 6,
+            light_faces: Vec::new(),
         })
     }
 
@@ -628,6 +639,31 @@ impl TranslucencyPass {
     pub fn params(&self) -> &PipelineParams {
         &self.params
     }
+}
+
+/// The faces of a point light's six-face map that the object's box can reach: a face is left
+/// out when all eight box corners lie outside one of its pyramid's four side planes
+/// (conservative: a face drawn in vain costs time, a face missed would lose the thickness).
+/// A light inside the box needs all six.
+fn needed_faces(light: DVec3, frame: &AccumulationFrame) -> Vec<u32> {
+    let corners: Vec<DVec3> = (0..8)
+        .map(|i| {
+            let s = DVec3::new(
+                if i & 1 == 0 { -1.0 } else { 1.0 },
+                if i & 2 == 0 { -1.0 } else { 1.0 },
+                if i & 4 == 0 { -1.0 } else { 1.0 },
+            );
+            frame.centre + s * frame.half_extent - light
+        })
+        .collect();
+    (0..6u32)
+        .filter(|&f| {
+            let [fwd, right, up] = cube::FACES[f as usize];
+            [fwd - right, fwd + right, fwd - up, fwd + up]
+                .iter()
+                .all(|n| corners.iter().any(|v| v.dot(*n) >= 0.0))
+        })
+        .collect()
 }
 
 /// Orthonormal (forward, right, up) for a directional light's map: forward = −l.
@@ -752,7 +788,7 @@ impl TranslucencyPass {
                         faces[3 * f + k] = vec4(*a, 0.0);
                     }
                 }
-                self.light_faces = 6;
+                self.light_faces = needed_faces(p, &frame);
                 let pc = p - c;
                 let far = pc.length() + radius;
                 (vec4(pc, 1.0), far * 1e-5, far)
@@ -761,13 +797,13 @@ impl TranslucencyPass {
                 for (k, a) in directional_basis(l).iter().enumerate() {
                     faces[k] = vec4(*a, 0.0);
                 }
-                self.light_faces = 1;
+                self.light_faces = vec![0];
                 (vec4(l, 0.0), 0.0, 0.0)
             }
         };
         let (tr, tp) = (material.sigma_tr(), material.sigma_t_prime());
         let h = self.params.window.factors();
-        let uniform = ParamsUniform {
+        let mut uniform = ParamsUniform {
             half_extent: vec4(frame.half_extent, 6.0),
             light: light_vec,
             eye: vec4(eye - c, 1.0),
@@ -803,6 +839,18 @@ impl TranslucencyPass {
             ],
             light_faces: faces,
         };
+        // Instance i of the light passes draws face light_faces[i].
+        for (i, &f) in self.light_faces.iter().enumerate() {
+            uniform.light_faces[3 * i + 1][3] = f as f32;
+        }
+        let mut blur = BlurUniform {
+            size: [self.params.light_map_size as f32, 0.0, 0.0, 0.0],
+            faces: [[0; 4]; 2],
+        };
+        for (i, &f) in self.light_faces.iter().enumerate() {
+            blur.faces[i / 4][i % 4] = f;
+        }
+        queue.write_buffer(&self.blur_uniform, 0, bytemuck::bytes_of(&blur));
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&uniform));
         queue.write_buffer(&self.window_buffer, 0, bytemuck::bytes_of(&uniform.window));
         let mut times = PassTimes::default();
@@ -852,7 +900,7 @@ impl TranslucencyPass {
 
         // 3–4. The light distance map and its peeled layer.
         let mut encoder = new_encoder("translucency light map");
-        let faces = self.light_faces;
+        let faces = self.light_faces.len() as u32;
         self.draw_offscreen(
             &mut encoder,
             m,
@@ -889,8 +937,8 @@ impl TranslucencyPass {
             ] {
                 pass.set_pipeline(pipe);
                 pass.set_bind_group(0, group, &[]);
-                // Only the face slots in use (one for a directional light).
-                pass.dispatch_workgroups(size.div_ceil(8), (faces * size).div_ceil(8), 1);
+                // Only the faces in use (one for a directional light).
+                pass.dispatch_workgroups(size.div_ceil(8), size.div_ceil(8), faces);
             }
         }
         step(device, &mut times.blur, encoder)?;

@@ -75,7 +75,10 @@ fn light_distance(x: vec3<f32>) -> f32 {
 }
 
 @vertex
-fn vs_light(v: MeshIn, @builtin(instance_index) face: u32) -> LightOut {
+fn vs_light(v: MeshIn, @builtin(instance_index) instance: u32) -> LightOut {
+    // Only the faces the object's box reaches are drawn: instance i draws the face stored in
+    // the w of entry 3i + 1 (gpu.rs: needed_faces).
+    let face = u32(params.light_faces[3u * instance + 1u].w);
     let f = params.light_faces[3u * face].xyz;
     let r = params.light_faces[3u * face + 1u].xyz;
     let u = params.light_faces[3u * face + 2u].xyz;

@@ -124,7 +124,8 @@ mod gpu_frame {
 
     /// Render `shape` in black with translucency added; compare every interior pixel of the slab's
     /// far face (z = −w/2, facing the camera) with eq. 12 evaluated in f64 with the GPU's own E_lm.
-    pub fn slab_frame_against_cpu(offset: DVec3, scale: f64) -> (f64, usize) {
+    /// `point`: a point light 0.5 × scale behind the slab instead of a directional one.
+    pub fn slab_frame_against_cpu(offset: DVec3, scale: f64, point: bool) -> (f64, usize) {
         let gpu = gpu_context::testing::gpu_or_skip().expect("checked by the caller");
         let mut renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
         let params = PipelineParams {
@@ -144,7 +145,11 @@ mod gpu_frame {
             .with_scale(1000.0 / scale)
             .unwrap();
         let light_dir = DVec3::new(0.2, 0.1, 1.0).normalize();
-        let light = Light::Directional(light_dir);
+        let light = if point {
+            Light::Point(offset + light_dir * 0.5 * scale)
+        } else {
+            Light::Directional(light_dir)
+        };
         let irr = model::transmitted_irradiance(
             &s.positions,
             &s.normals.iter().map(|n| n.as_dvec3()).collect::<Vec<_>>(),
@@ -210,8 +215,9 @@ mod gpu_frame {
                 if local.x.abs() > 0.035 * scale || local.y.abs() > 0.035 * scale {
                     continue;
                 }
-                // The chord along the oblique light: w / l_z.
-                let chord = w / light_dir.z;
+                // The chord along the oblique light ray through the hit point: w / |cos|.
+                let towards = light.towards(hit);
+                let chord = w / towards.z.abs();
                 let want = model::scattered_radiance(
                     &material,
                     &sh,
