@@ -7,7 +7,8 @@
 //! (`xtask/scripts/mitsuba_translucency.py`) writes the scenes, runs the release `cloth-vis`
 //! binary and Mitsuba, prints the table and writes the pictures to
 //! `target/translucency-compare/`. `--quick` (CI) renders the 1,000-triangle bunny at 96²
-//! with 32 samples per pixel.
+//! with 32 samples per pixel; `--cloth-vis PATH` uses a binary already built (CI's test
+//! profile) instead of building the release one.
 
 use std::path::Path;
 use std::process::Command;
@@ -24,8 +25,8 @@ fn run(cmd: &mut Command) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Run the comparison.
-pub fn run_comparison(root: &Path, quick: bool) -> anyhow::Result<()> {
+/// Run the comparison with the `cloth-vis` binary at `binary` (built in release when `None`).
+pub fn run_comparison(root: &Path, quick: bool, binary: Option<&Path>) -> anyhow::Result<()> {
     let data = root.join("../shared/data");
     if !data.join("meshes/bun_zipper.ply").is_file() {
         bail!(
@@ -45,14 +46,26 @@ pub fn run_comparison(root: &Path, quick: bool) -> anyhow::Result<()> {
             "pillow",
         ]))?;
     }
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    run(Command::new(&cargo)
-        .current_dir(root)
-        .args(["build", "--release", "-p", "cloth-vis"]))?;
+    let binary = match binary {
+        Some(path) => path.to_owned(),
+        None => {
+            let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+            run(Command::new(&cargo).current_dir(root).args([
+                "build",
+                "--release",
+                "-p",
+                "cloth-vis",
+            ]))?;
+            root.join("target/release/cloth-vis")
+        }
+    };
+    if !binary.is_file() {
+        bail!("{}: no cloth-vis binary there", binary.display());
+    }
     let mut script = Command::new(&python);
     script
         .arg(root.join("xtask/scripts/mitsuba_translucency.py"))
-        .arg(root.join("target/release/cloth-vis"))
+        .arg(&binary)
         .arg(root.join("target/translucency-compare"))
         .arg(&data);
     if quick {

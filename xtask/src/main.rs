@@ -89,6 +89,9 @@ enum Compare {
         /// The small bunny at 96², 32 samples per pixel.
         #[arg(long)]
         quick: bool,
+        /// A cloth-vis binary to use (default: build the release one).
+        #[arg(long, value_name = "PATH")]
+        cloth_vis: Option<PathBuf>,
     },
 }
 
@@ -200,10 +203,10 @@ fn main() -> anyhow::Result<()> {
             compare_clustering::run_comparison(&root, quick)
         }
         Command::Compare {
-            what: Compare::Translucency { quick },
+            what: Compare::Translucency { quick, cloth_vis },
         } => {
             let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-            compare_translucency::run_comparison(&root, quick)
+            compare_translucency::run_comparison(&root, quick, cloth_vis.as_deref())
         }
     }
 }
