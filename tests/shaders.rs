@@ -2,7 +2,8 @@
 //! validates with naga (the compiler wgpu uses), so a broken shader fails here on any machine,
 //! GPU or not. Passes of the shared frame (crate `render`) use the view binding of
 //! `crates/render/src/view.wgsl` without declaring it: they are validated with it prepended,
-//! exactly as their crates compile them.
+//! exactly as their crates compile them; a file that names a sibling in a `// requires:
+//! FILE.wgsl` line gets that sibling prepended as well (translucency's shared `common.wgsl`).
 
 use std::path::{Path, PathBuf};
 
@@ -40,10 +41,20 @@ fn every_shader_in_the_workspace_parses_and_validates() {
         let own = std::fs::read_to_string(path).unwrap();
         // A frame pass reads `view.` and leaves its declaration to view.wgsl.
         let needs_view = own.contains("view.") && !own.contains("var<uniform> view");
+        let mut prelude = String::new();
+        for line in own.lines() {
+            if let Some(name) = line.trim().strip_prefix("// requires: ") {
+                let sibling = path.with_file_name(name.trim());
+                prelude.push_str(&std::fs::read_to_string(&sibling).unwrap_or_else(|e| {
+                    panic!("{}: requires {}: {e}", path.display(), sibling.display())
+                }));
+                prelude.push('\n');
+            }
+        }
         let source = if needs_view {
-            format!("{view}\n{own}")
+            format!("{view}\n{prelude}{own}")
         } else {
-            own
+            format!("{prelude}{own}")
         };
         let module = naga::front::wgsl::parse_str(&source)
             .unwrap_or_else(|e| panic!("{}: {}", path.display(), e.emit_to_string(&source)));

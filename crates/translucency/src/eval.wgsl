@@ -1,6 +1,7 @@
 // Seed 004's evaluation (TR 150, eq. 12 per pixel) in the shared frame: the surfaces the
 // opaque pass drew are drawn again with depth `Equal` and L^e is added. `view.wgsl` and
 // `common.wgsl` are prepended.
+// requires: common.wgsl
 
 @group(1) @binding(0) var<uniform> params: Params;
 // E_lm (27 floats), then M per channel, 4 columns each (reduce.wgsl: sh_final).

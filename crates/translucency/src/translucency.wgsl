@@ -1,6 +1,7 @@
 // Seed 004's per-frame pipeline (Banterle & Chalmers; SEED-NOTES §5.2). Positions of the
 // internal passes are relative to the accumulation point (the bounding box's centre), so a mesh
 // far from the origin keeps its precision. `common.wgsl` is prepended.
+// requires: common.wgsl
 
 const EMPTY: f32 = 1e30;
 
