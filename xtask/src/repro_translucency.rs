@@ -118,13 +118,9 @@ fn frames(
         let normals =
             meshio::compute_normals(&positions, &mesh.triangles, meshio::NormalWeighting::Angle);
         let p64: Vec<DVec3> = positions.iter().map(|p| p.as_dvec3()).collect();
-        let n64: Vec<DVec3> = normals.iter().map(|n| n.as_dvec3()).collect();
         let power = [(light_position(&light) - centre.as_dvec3()).length_squared(); 3];
-        let e_t: Vec<[f32; 3]> =
-            model::transmitted_irradiance(&p64, &n64, &light, power, material.eta, |_| 1.0)
-                .iter()
-                .map(|e| e.map(|v| v as f32))
-                .collect();
+        let e_t =
+            model::transmitted_irradiance(&p64, &normals, &light, power, material.eta, |_| 1.0);
         let rd = material.diffuse_reflectance();
         let direct: Vec<Vec3> = e_t
             .iter()
@@ -252,14 +248,10 @@ fn cube_sizes(md: &mut String, gpu: &gpu_context::GpuContext) -> anyhow::Result<
         meshio::NormalWeighting::Angle,
     );
     let p64: Vec<DVec3> = mesh.positions.iter().map(|p| p.as_dvec3()).collect();
-    let n64: Vec<DVec3> = normals.iter().map(|n| n.as_dvec3()).collect();
     let light = Light::Point(DVec3::new(-0.1, 0.25, -0.25));
     let material = Material::preset("skin1")?;
-    let e_t: Vec<[f32; 3]> =
-        model::transmitted_irradiance(&p64, &n64, &light, [1.0; 3], material.eta, |_| 1.0)
-            .iter()
-            .map(|e| e.map(|v| v as f32))
-            .collect();
+    let e_t =
+        model::transmitted_irradiance(&p64, &normals, &light, [1.0; 3], material.eta, |_| 1.0);
     let renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
     let mut results = Vec::new();
     for size in [32, 64, 128, 256] {

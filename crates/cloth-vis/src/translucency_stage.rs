@@ -195,7 +195,6 @@ impl TranslucencyStage {
             let o = &mut objects[i];
             let base = positions.len() as u32;
             let p: Vec<DVec3> = o.positions.iter().map(|v| v.as_dvec3()).collect();
-            let n: Vec<DVec3> = o.normals.iter().map(|v| v.as_dvec3()).collect();
             let e_t = match self.source {
                 Source::Light(light, power) => {
                     // Unchanged since the last frame: start again from what was there before.
@@ -210,7 +209,7 @@ impl TranslucencyStage {
                         before,
                         after: (o.front.clone(), o.back.clone()),
                     });
-                    model::transmitted_irradiance(&p, &n, &light, power, eta, |_| 1.0)
+                    model::transmitted_irradiance(&p, &o.normals, &light, power, eta, |_| 1.0)
                 }
                 Source::Environment(_) => {
                     let r0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
@@ -220,7 +219,8 @@ impl TranslucencyStage {
                         Some(front) => front
                             .iter()
                             .map(|c| {
-                                (c.as_dvec3() * std::f64::consts::PI / rho * mean_ft).to_array()
+                                let e = c.as_dvec3() * std::f64::consts::PI / rho * mean_ft;
+                                e.as_vec3().to_array()
                             })
                             .collect(),
                         None => vec![[0.0; 3]; p.len()],
@@ -230,7 +230,7 @@ impl TranslucencyStage {
             positions.extend(p);
             normals.extend(o.normals.iter().copied());
             triangles.extend(o.triangles.iter().map(|t| t.map(|v| v + base)));
-            irradiance.extend(e_t.iter().map(|e| e.map(|v| v as f32)));
+            irradiance.extend(e_t);
         }
         let light = match self.source {
             Source::Light(light, _) => light,

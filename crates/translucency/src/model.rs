@@ -3,7 +3,7 @@
 //! "blindness" and "shift" fixes, and L^e per point (eq. 12) — the reference the GPU pass is
 //! checked against.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
 
 use crate::error::{TranslucencyError, bad_parameter};
@@ -217,29 +217,29 @@ pub fn scattered_radiance(
 /// The lit object's transmitted irradiance at each vertex under a point or directional light
 /// of RGB intensity `intensity` (W/sr for a point, irradiance for a directional light):
 /// E_t = F_t(η, n·l) · E · max(0, n·l), with 1/r² for a point light — what the cube map
-/// stores (pass 1). `visible(i)` scales vertex i (1 = lit; the facade passes self-shadowing).
+/// stores (pass 1), as the f32 the GPU takes. `visible(i)` scales vertex i (1 = lit).
 #[must_use]
 pub fn transmitted_irradiance(
     positions: &[DVec3],
-    normals: &[DVec3],
+    normals: &[Vec3],
     light: &Light,
     intensity: [f64; 3],
     eta: f64,
     visible: impl Fn(usize) -> f64,
-) -> Vec<[f64; 3]> {
+) -> Vec<[f32; 3]> {
     positions
         .iter()
         .zip(normals)
         .enumerate()
         .map(|(i, (&x, &n))| {
             let l = light.towards(x);
-            let cos = n.normalize_or_zero().dot(l).max(0.0);
+            let cos = n.as_dvec3().normalize_or_zero().dot(l).max(0.0);
             let falloff = match *light {
                 Light::Point(p) => 1.0 / (p - x).length_squared().max(f64::MIN_POSITIVE),
                 Light::Directional(_) => 1.0,
             };
             let s = schlick_transmittance(eta, cos) * cos * falloff * visible(i);
-            intensity.map(|v| v * s)
+            intensity.map(|v| (v * s) as f32)
         })
         .collect()
 }

@@ -76,12 +76,12 @@ mod gpu {
     use super::*;
     use common::*;
     use glam::Vec3;
-    use render::{Background, Camera, DrawMesh, FrameFormat, Renderer};
+    use render::{FrameFormat, Renderer};
     use translucency::Material;
     use translucency::gpu::{PipelineParams, TranslucentMesh};
     use translucency::model::{self, Light};
 
-    /// Render `s` in black plus translucency; the image's pixels.
+    /// Render `s` in black plus translucency (skim milk); the image's pixels.
     fn render(
         s: &Shape,
         light: Light,
@@ -89,55 +89,9 @@ mod gpu {
         target: DVec3,
         params: PipelineParams,
     ) -> Vec<[f32; 4]> {
-        let gpu = gpu_context::testing::gpu_or_skip().expect("checked by the caller");
-        let mut renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
-        let mut p = pass(&gpu, &renderer, params);
         let material = Material::preset("skimmilk").unwrap();
-        let normals: Vec<DVec3> = s.normals.iter().map(|n| n.as_dvec3()).collect();
-        let irr: Vec<[f32; 3]> = model::transmitted_irradiance(
-            &s.positions,
-            &normals,
-            &light,
-            [1.0; 3],
-            material.eta,
-            |_| 1.0,
-        )
-        .iter()
-        .map(|e| e.map(|v| v as f32))
-        .collect();
-        let mesh = TranslucentMesh {
-            positions: &s.positions,
-            normals: &s.normals,
-            triangles: &s.triangles,
-            irradiance: &irr,
-        };
-        p.prepare(&gpu.device, &gpu.queue, &mesh, light, &material, eye, false)
-            .unwrap();
-        let world: Vec<Vec3> = s.positions.iter().map(|p| p.as_vec3()).collect();
-        let black = vec![Vec3::ZERO; world.len()];
-        renderer
-            .gouraud
-            .set_meshes(
-                &gpu.device,
-                &gpu.queue,
-                &[DrawMesh {
-                    positions: &world,
-                    triangles: &s.triangles,
-                    front: &black,
-                    back: &black,
-                }],
-            )
-            .unwrap();
-        let camera = Camera::look_at(eye.as_vec3(), target.as_vec3(), Vec3::Y, 40.0, 64, 64);
-        renderer
-            .render(
-                &gpu.device,
-                &gpu.queue,
-                &camera,
-                Background::Color([0.0; 3]),
-                &[&p],
-            )
-            .unwrap()
+        render_black(s, light, &material, eye, target, params, 64)
+            .image
             .pixels()
             .to_vec()
     }

@@ -42,24 +42,23 @@ fn blur_at(p: vec2<i32>, step: vec2<i32>) -> f32 {
     return sum / weight;
 }
 
-@compute @workgroup_size(8, 8)
-fn blur_h(@builtin(global_invocation_id) id: vec3<u32>) {
+// One texel of face `blur.faces[id.z]` filtered along `step`.
+fn blur_texel(id: vec3<u32>, step: vec2<i32>) {
     let face_size = u32(blur.size.x);
     if id.x >= face_size || id.y >= face_size {
         return;
     }
     let face = blur.faces[id.z / 4u][id.z % 4u];
     let p = vec2<i32>(vec2<u32>(id.x, id.y + face * face_size));
-    textureStore(blur_dst, p, vec4<f32>(blur_at(p, vec2<i32>(1, 0)), 0.0, 0.0, 0.0));
+    textureStore(blur_dst, p, vec4<f32>(blur_at(p, step), 0.0, 0.0, 0.0));
+}
+
+@compute @workgroup_size(8, 8)
+fn blur_h(@builtin(global_invocation_id) id: vec3<u32>) {
+    blur_texel(id, vec2<i32>(1, 0));
 }
 
 @compute @workgroup_size(8, 8)
 fn blur_v(@builtin(global_invocation_id) id: vec3<u32>) {
-    let face_size = u32(blur.size.x);
-    if id.x >= face_size || id.y >= face_size {
-        return;
-    }
-    let face = blur.faces[id.z / 4u][id.z % 4u];
-    let p = vec2<i32>(vec2<u32>(id.x, id.y + face * face_size));
-    textureStore(blur_dst, p, vec4<f32>(blur_at(p, vec2<i32>(0, 1)), 0.0, 0.0, 0.0));
+    blur_texel(id, vec2<i32>(0, 1));
 }

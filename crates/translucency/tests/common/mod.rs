@@ -122,17 +122,85 @@ mod gpu_frame {
         (far.truncate() / far.w - near.truncate() / near.w).normalize()
     }
 
+    /// What [`render_black`] leaves: the context, the pass (for read-backs), the image, the camera.
+    pub struct Rendered {
+        pub gpu: gpu_context::GpuContext,
+        pub pass: TranslucencyPass,
+        pub image: gpu_context::HdrImage,
+        pub camera: Camera,
+    }
+
+    /// Render `s` in black (single sample) with translucency added: E_t from `light` at unit
+    /// power, the camera at `eye` looking at `target`, `size`² pixels.
+    pub fn render_black(
+        s: &Shape,
+        light: Light,
+        material: &Material,
+        eye: DVec3,
+        target: DVec3,
+        params: PipelineParams,
+        size: u32,
+    ) -> Rendered {
+        let gpu = gpu_context::testing::gpu_or_skip().expect("checked by the caller");
+        let mut renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
+        let mut p = pass(&gpu, &renderer, params);
+        let irr = model::transmitted_irradiance(
+            &s.positions,
+            &s.normals,
+            &light,
+            [1.0; 3],
+            material.eta,
+            |_| 1.0,
+        );
+        let mesh = TranslucentMesh {
+            positions: &s.positions,
+            normals: &s.normals,
+            triangles: &s.triangles,
+            irradiance: &irr,
+        };
+        p.prepare(&gpu.device, &gpu.queue, &mesh, light, material, eye, false)
+            .unwrap();
+        let world: Vec<Vec3> = s.positions.iter().map(|p| p.as_vec3()).collect();
+        let black = vec![Vec3::ZERO; world.len()];
+        renderer
+            .gouraud
+            .set_meshes(
+                &gpu.device,
+                &gpu.queue,
+                &[DrawMesh {
+                    positions: &world,
+                    triangles: &s.triangles,
+                    front: &black,
+                    back: &black,
+                }],
+            )
+            .unwrap();
+        let camera = Camera::look_at(eye.as_vec3(), target.as_vec3(), Vec3::Y, 40.0, size, size);
+        let image = renderer
+            .render(
+                &gpu.device,
+                &gpu.queue,
+                &camera,
+                Background::Color([0.0; 3]),
+                &[&p],
+            )
+            .unwrap();
+        Rendered {
+            gpu,
+            pass: p,
+            image,
+            camera,
+        }
+    }
+
     /// Render `shape` in black with translucency added; compare every interior pixel of the slab's
     /// far face (z = −w/2, facing the camera) with eq. 12 evaluated in f64 with the GPU's own E_lm.
     /// `point`: a point light 0.5 × scale behind the slab instead of a directional one.
     pub fn slab_frame_against_cpu(offset: DVec3, scale: f64, point: bool) -> (f64, usize) {
-        let gpu = gpu_context::testing::gpu_or_skip().expect("checked by the caller");
-        let mut renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
         let params = PipelineParams {
             window: Window::Gaussian { width: 5.0 },
             ..Default::default()
         };
-        let mut p = pass(&gpu, &renderer, params);
         // Metres × scale; the material's millimetres follow.
         let w = 0.01 * scale;
         let s = cuboid(
@@ -150,50 +218,14 @@ mod gpu_frame {
         } else {
             Light::Directional(light_dir)
         };
-        let irr = model::transmitted_irradiance(
-            &s.positions,
-            &s.normals.iter().map(|n| n.as_dvec3()).collect::<Vec<_>>(),
-            &light,
-            [1.0, 1.0, 1.0],
-            material.eta,
-            |_| 1.0,
-        );
-        let irr: Vec<[f32; 3]> = irr.iter().map(|e| e.map(|v| v as f32)).collect();
         let eye = DVec3::new(0.03, -0.02, -0.3) * scale + offset;
-        let mesh = TranslucentMesh {
-            positions: &s.positions,
-            normals: &s.normals,
-            triangles: &s.triangles,
-            irradiance: &irr,
-        };
-        p.prepare(&gpu.device, &gpu.queue, &mesh, light, &material, eye, false)
-            .unwrap();
-        let world: Vec<Vec3> = s.positions.iter().map(|p| p.as_vec3()).collect();
-        let black = vec![Vec3::ZERO; world.len()];
-        renderer
-            .gouraud
-            .set_meshes(
-                &gpu.device,
-                &gpu.queue,
-                &[DrawMesh {
-                    positions: &world,
-                    triangles: &s.triangles,
-                    front: &black,
-                    back: &black,
-                }],
-            )
-            .unwrap();
         let size = 64;
-        let camera = Camera::look_at(eye.as_vec3(), offset.as_vec3(), Vec3::Y, 40.0, size, size);
-        let image = renderer
-            .render(
-                &gpu.device,
-                &gpu.queue,
-                &camera,
-                Background::Color([0.0; 3]),
-                &[&p],
-            )
-            .unwrap();
+        let Rendered {
+            gpu,
+            pass: p,
+            image,
+            camera,
+        } = render_black(&s, light, &material, eye, offset, params, size);
         let sh = p
             .read_coefficients(&gpu.device, &gpu.queue)
             .unwrap()
