@@ -200,6 +200,12 @@ impl Scene {
                 "give a preset or sigma_a + sigma_s, not both".to_owned(),
             ));
         }
+        if !(t.mm_per_unit.is_finite() && t.mm_per_unit > 0.0) {
+            return Err(self.invalid(
+                "translucency.mm_per_unit",
+                format!("{} must be finite and > 0", t.mm_per_unit),
+            ));
+        }
         let key = if t.sigma_a.is_some() {
             "translucency.sigma_a"
         } else {
