@@ -209,7 +209,7 @@ impl Sh9 {
     }
 
     /// Project a cube map: Σ texel · Y_lm(texel centre) · Δω with the texel's exact solid
-    /// angle ([`CubeMap::texel_solid_angle`]); second-order accurate in the texel size.
+    /// angle ([`crate::cube::texel_solid_angle`]); second-order accurate in the texel size.
     #[must_use]
     pub fn project_cube(cube: &CubeMap) -> Self {
         let mut out = Self::default();

@@ -93,7 +93,7 @@ fn check_mesh(mesh: &TranslucentMesh<'_>) -> Result<(), TranslucencyError> {
 
 impl TranslucencyPass {
     /// Run passes 1–5 for this frame's mesh, light, material and eye (world), leaving the
-    /// matrices and the light maps on the GPU for [`FramePass::record`]. With `timed`, each
+    /// matrices and the light maps on the GPU for [`render::FramePass::record`]. With `timed`, each
     /// pass is submitted and waited for, so [`PassTimes`] holds per-pass times (the frame is
     /// then slower than with one submission).
     ///

@@ -36,7 +36,7 @@ impl TranslucencyPass {
     /// It overwrites this frame's cube map.
     ///
     /// # Errors
-    /// A face size other than [`PipelineParams::cube_size`]; a failed read-back.
+    /// A face size other than [`super::PipelineParams::cube_size`]; a failed read-back.
     pub fn project_on_gpu(
         &self,
         device: &wgpu::Device,
