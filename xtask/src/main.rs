@@ -32,12 +32,16 @@
 //! - `cargo xtask repro translucency [--quick]`: seed 004's Table 1 (per-pass times on the
 //!   bunny and the dragon, static and under the sine deformer, beside the paper's fps), the
 //!   cube-map size against E_lm (TR 164), SH ringing per window (`target/repro/translucency.md`).
+//! - `cargo xtask bench visibility [--quick] [--threads 2]`: occlusion-gpu's `cpu` backend
+//!   beside Mitsuba 3 (Embree) and Open3D on the same rays, as ratios
+//!   (`target/repro/bench-visibility.md`; the peers in a virtual environment).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 //! - `cargo xtask compare translucency [--quick]`: seed 004's translucency model against
 //!   Mitsuba 3's volumetric path tracer on the bunny and the dragon (image error and SSIM
 //!   beside plain diffuse shading's; Mitsuba in a virtual environment).
 
+mod bench_visibility;
 mod compare_clustering;
 mod compare_translucency;
 mod repro_anim_compression;
@@ -69,10 +73,29 @@ enum Command {
         #[command(subcommand)]
         what: Repro,
     },
+    /// Benchmarks beside the tools users would pick instead, in one run.
+    Bench {
+        #[command(subcommand)]
+        what: Bench,
+    },
     /// Compare a crate with the tools users would pick instead, on the same data.
     Compare {
         #[command(subcommand)]
         what: Compare,
+    },
+}
+
+#[derive(Subcommand)]
+enum Bench {
+    /// occlusion-gpu's `cpu` backend beside Mitsuba 3 (Embree) and Open3D on the same rays:
+    /// bunny k = 6 … 1026, dragon and igea at k = 258, the drape at k = 66 and 258.
+    Visibility {
+        /// The bunny at k = 66 and 258 only.
+        #[arg(long)]
+        quick: bool,
+        /// Threads for every library.
+        #[arg(long, default_value_t = 2)]
+        threads: usize,
     },
 }
 
@@ -196,6 +219,12 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Translucency { quick },
         } => repro_translucency::run(&repro_dir()?, quick),
+        Command::Bench {
+            what: Bench::Visibility { quick, threads },
+        } => {
+            let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+            bench_visibility::run(&root, &repro_dir()?, quick, threads)
+        }
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {
