@@ -427,7 +427,14 @@ fn check_range(scene: &Scene, objects: &[WorldObject], range: FrameRange) -> Res
             origin: scene.origin.clone(),
             message: format!(
                 "output.frames = {range}: no object is animated (use an animation source: \
-                 synth:cloth, .npy, an OBJ frame folder or an animated glTF)"
+                 synth:cloth, .npy, an OBJ frame folder or an animated glTF{})",
+                if scene.effects.iter().any(|e| e == "translucency")
+                    && scene.translucency.deform.is_none()
+                {
+                    "; or [translucency] deform = {…} — `--deform A,K,N` — to sway a static mesh"
+                } else {
+                    ""
+                }
             ),
         });
     }

@@ -442,6 +442,16 @@ pub fn run_visibility(
                     vec![n, k]
                 };
                 meshio::write_npy_f32(path, &shape, &matrices)?;
+                // Beside M, what it needs outside the tool: l_j and ω_j (a_i = Σ_j M_ij ω_j / π).
+                let (directions, weights) = matrix_sidecars(path);
+                let dirs: Vec<f32> = sphere
+                    .directions()
+                    .iter()
+                    .flat_map(|d| d.to_array())
+                    .collect();
+                meshio::write_npy_f32(&directions, &[k, 3], &dirs)?;
+                let omega: Vec<f32> = sphere.solid_angles().iter().map(|w| *w as f32).collect();
+                meshio::write_npy_f32(&weights, &[k], &omega)?;
             } else {
                 let shape: Vec<usize> = if count > 1 { vec![count, n] } else { vec![n] };
                 meshio::write_npy_f32(path, &shape, &ambient)?;
@@ -634,7 +644,9 @@ pub struct VisibilityArgs {
     /// frame: linear float COLOR_0, float `_AO` = a_i, -1 for unused vertices).
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Write the matrix M instead of a_i (.npy only).
+    /// Write the matrix M (M_ij = n_i·l_j where vertex i sees direction j, else 0) instead of
+    /// a_i (.npy only), with STEM.directions.npy (l_j, f32 [k, 3], world +Y up) and
+    /// STEM.weights.npy (ω_j, f32 [k], summing to 4π) beside it: a_i = Σ_j M_ij ω_j / π.
     #[arg(long)]
     matrix: bool,
     /// Frames A..B of an animation (end exclusive).
@@ -703,4 +715,16 @@ impl VisibilityArgs {
         };
         super::print_line(&run_visibility(&request, gpu.as_ref())?.line())
     }
+}
+
+/// The sidecars of `--matrix` output `path`: STEM.directions.npy and STEM.weights.npy.
+pub(crate) fn matrix_sidecars(path: &Path) -> (PathBuf, PathBuf) {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    (
+        path.with_file_name(format!("{stem}.directions.npy")),
+        path.with_file_name(format!("{stem}.weights.npy")),
+    )
 }

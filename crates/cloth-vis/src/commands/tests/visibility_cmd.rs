@@ -81,6 +81,23 @@ fn ambient_npy_keeps_vertex_order_with_nan_for_unused_vertices() {
         .sum::<f64>()
         / std::f64::consts::PI;
     assert!((a0 as f32 - array.data[0]).abs() < 1e-5);
+    // The sidecars carry l_j and ω_j: a_i from them alone, ω summing to 4π.
+    let dirs = meshio::read_npy_f32(&dir.path().join("m.directions.npy")).unwrap();
+    let w = meshio::read_npy_f32(&dir.path().join("m.weights.npy")).unwrap();
+    assert_eq!(
+        (dirs.shape.clone(), w.shape.clone()),
+        (vec![66, 3], vec![66])
+    );
+    assert_eq!(dirs.data[..3], sphere.directions()[0].to_array());
+    let total: f64 = w.data.iter().map(|v| f64::from(*v)).sum();
+    assert!((total - 4.0 * std::f64::consts::PI).abs() < 1e-5, "{total}");
+    let a0: f32 = m.data[..66]
+        .iter()
+        .zip(&w.data)
+        .map(|(v, w)| v * w)
+        .sum::<f32>()
+        / std::f32::consts::PI;
+    assert!((a0 - array.data[0]).abs() < 1e-5);
 }
 
 #[test]
