@@ -110,6 +110,11 @@ pub struct CpuParams {
     /// rebuilding once its SAH cost exceeds [`crate::REBUILD_SAH_RATIO`] × the build's; false
     /// rebuilds every time the geometry changes.
     pub refit: bool,
+    /// Keep a refitted tree only while its measured extra traversal time stays below the last
+    /// build's time (the default: adapts to k and the mesh, but depends on the machine's
+    /// timings); false keeps it up to [`crate::REBUILD_SAH_RATIO`] whatever the clock says —
+    /// the same refit/rebuild sequence on every run, for tests and reproducible reports.
+    pub refit_timed: bool,
 }
 
 impl Default for CpuParams {
@@ -118,6 +123,7 @@ impl Default for CpuParams {
             offset_relative: DEFAULT_OFFSET_RELATIVE,
             method: CpuMethod::default(),
             refit: true,
+            refit_timed: true,
         }
     }
 }
@@ -132,6 +138,13 @@ impl CpuParams {
     /// The same parameters with refitting on or off.
     pub fn with_refit(mut self, refit: bool) -> Self {
         self.refit = refit;
+        self
+    }
+
+    /// The same parameters with refits kept by measured time (`true`, the default) or by the
+    /// SAH cap alone (`false`, deterministic); see [`CpuParams::refit_timed`].
+    pub fn with_refit_timed(mut self, timed: bool) -> Self {
+        self.refit_timed = timed;
         self
     }
 }
