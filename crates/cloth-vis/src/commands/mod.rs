@@ -11,10 +11,12 @@ mod cpca_search;
 pub mod hemicube;
 pub mod inspect;
 pub mod jumpmap;
+mod output_size;
 pub mod parse;
 pub mod render;
 pub mod shadows;
 pub mod translucency;
+pub mod up_axis;
 pub mod visibility;
 
 #[cfg(test)]

@@ -43,10 +43,11 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::invalid;
+use super::up_axis::{UpAxis, up_axis_rotation};
+use super::{invalid, output_size};
 use cloth_vis::Error;
 use cloth_vis::lighting::{environment_rotation, shadowed_radiance};
-use cloth_vis::run::render_still_image;
+use cloth_vis::run::{progress_bar, render_still_image};
 use cloth_vis::scene::{
     AutoKeyword, BackgroundDesc, BackgroundKeyword, ExposureDesc, Scene, ToneDesc,
     VisibilityBackendDesc,
@@ -99,6 +100,14 @@ pub struct VisibilityRequest {
     pub gamma: f32,
     /// Rendered image size `[width, height]` in pixels.
     pub render_size: [u32; 2],
+    /// The input's up axis (`+Y` for most tools, `+Z` for CAD and Blender exports): the
+    /// environment's zenith and the render camera's up are turned onto it
+    /// ([`up_axis_rotation`]); positions, normals, a_i and M stay in the input's frame.
+    pub up_axis: UpAxis,
+    /// A progress bar over the frames of an animation on stderr.
+    pub progress: bool,
+    /// Write an output estimated above [`output_size::REFUSE_BYTES`] anyway.
+    pub force: bool,
 }
 
 #[cfg(test)]
@@ -121,6 +130,9 @@ impl VisibilityRequest {
             exposure_ev: None,
             gamma: DEFAULT_GAMMA,
             render_size: super::parse::size(DEFAULT_RENDER_SIZE).expect("the default parses"),
+            up_axis: UpAxis::PosY,
+            progress: false,
+            force: false,
         }
     }
 }
@@ -308,6 +320,9 @@ fn one_object_scene(request: &VisibilityRequest) -> Result<Scene, Error> {
         Some(Backend::Query) => VisibilityBackendDesc::Query,
     };
     scene.visibility.depth_resolution = request.depth_resolution;
+    let up = up_axis_rotation(request.up_axis).as_quat();
+    scene.camera.up = (up * Vec3::Y).to_array();
+    scene.camera.direction = (up * Vec3::from(scene.camera.direction)).to_array();
     Ok(scene)
 }
 
@@ -395,8 +410,11 @@ pub fn run_visibility(
     }
     let mut stage = VisibilityStage::new(&scene, gpu).map_err(|e| invalid(input, e.to_string()))?;
     // Rotating the environment turns its backdrop and its I_j alike; M is computed once.
+    // With another up axis the zenith turns onto it and --env-rotation turns about it.
     let environment = request.environment.clone().map(|env| {
-        let world_from_env = environment_rotation(request.env_rotation_deg) * env.world_from_env();
+        let up = up_axis_rotation(request.up_axis).as_quat();
+        let world_from_env =
+            up * environment_rotation(request.env_rotation_deg) * env.world_from_env();
         env.with_rotation(world_from_env)
     });
     let light = match &environment {
@@ -405,10 +423,19 @@ pub fn run_visibility(
     };
     let n = objects[0].positions.len();
     let k = sphere.len();
-    let mut ambient = Vec::with_capacity((end - start) * n);
+    let count = end - start;
+    if let (Some(path), true) = (&request.out, request.matrix) {
+        let bytes = (count * n) as u64 * k as u64 * 4;
+        let levers = "lower --level or pass fewer --frames";
+        if let Some(line) = output_size::check(path, "M", bytes, levers, request.force)? {
+            eprintln!("{line}");
+        }
+    }
+    let mut ambient = Vec::with_capacity(count * n);
     let mut matrices = Vec::new();
     let mut last = None;
     let mut millis = 0.0;
+    let bar = progress_bar(request.progress && count > 1, count as u64, "frames");
     for frame in start..end {
         objects[0].pose(frame);
         let t = Instant::now();
@@ -419,8 +446,9 @@ pub fn run_visibility(
             matrices.extend(visibility.matrix().to_dense());
         }
         last = Some(visibility);
+        bar.inc(1);
     }
-    let count = end - start;
+    bar.finish_and_clear();
     let visibility = last.ok_or_else(|| invalid(input, "no frame to compute".to_owned()))?;
     let last_ambient = &ambient[(count - 1) * n..];
     // c_i = (1/π) Σ_j M_ij I_j ω_j of a white surface (NaN for unused vertices), or the grey
@@ -630,7 +658,7 @@ pub struct VisibilityArgs {
     /// Use the procedural sky as the environment (see --env).
     #[arg(long)]
     sky: bool,
-    /// Rotate the environment by DEG degrees about +Y relative to the object (rotated
+    /// Rotate the environment by DEG degrees about the up axis (+Y) relative to the object (rotated
     /// look-ups of I_j; M is not recomputed). Needs --env or --sky.
     #[arg(
         long,
@@ -666,6 +694,16 @@ pub struct VisibilityArgs {
     /// Rendered image size.
     #[arg(long, value_name = "WxH", value_parser = super::parse::size, default_value = DEFAULT_RENDER_SIZE)]
     render_size: [u32; 2],
+    /// The input's up axis: the environment's zenith and the render camera's up turn onto it
+    /// (z for Blender/CAD exports); the outputs stay in the input's frame.
+    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
+    up_axis: UpAxis,
+    /// Hide the progress bar over the frames of an animation.
+    #[arg(long)]
+    quiet: bool,
+    /// Write a --matrix output estimated above 8 GB anyway (one from 1 GB on is announced).
+    #[arg(long)]
+    force: bool,
 }
 
 impl VisibilityArgs {
@@ -712,6 +750,9 @@ impl VisibilityArgs {
             exposure_ev: self.exposure,
             gamma: self.gamma,
             render_size: self.render_size,
+            up_axis: self.up_axis,
+            progress: !self.quiet,
+            force: self.force,
         };
         super::print_line(&run_visibility(&request, gpu.as_ref())?.line())
     }

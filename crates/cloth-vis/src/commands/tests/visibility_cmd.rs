@@ -278,3 +278,36 @@ fn point_caches_with_a_topology_mesh_match_the_obj_folder() {
     let message = run(&pc2, None, "none.npy").unwrap_err().to_string();
     assert!(message.contains("--topology"), "{message}");
 }
+
+#[test]
+fn a_matrix_above_8_gb_is_refused_before_the_first_ray() {
+    // 182² = 33,124 vertices × 65,538 directions (level 7) × 4 bytes = 8.7 GB > 8 GiB.
+    let dir = tempfile::tempdir().unwrap();
+    let side = 182;
+    let mut text = String::new();
+    for i in 0..side {
+        for j in 0..side {
+            text.push_str(&format!("v {i} 0 {j}\n"));
+        }
+    }
+    for i in 0..side - 1 {
+        for j in 0..side - 1 {
+            let a = i * side + j + 1;
+            text.push_str(&format!("f {a} {} {}\n", a + 1, a + side + 1));
+        }
+    }
+    let input = dir.path().join("big.obj");
+    std::fs::write(&input, text).unwrap();
+    let out = dir.path().join("m.npy");
+    let big = VisibilityRequest {
+        level: 7,
+        matrix: true,
+        ..request(input, Some(out.clone()))
+    };
+    let message = run_visibility(&big, None).unwrap_err().to_string();
+    assert!(
+        message.contains("m.npy") && message.contains("8.7 GB") && message.contains("--force"),
+        "{message}"
+    );
+    assert!(!out.exists());
+}

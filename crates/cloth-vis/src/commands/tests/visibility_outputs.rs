@@ -511,3 +511,59 @@ fn png_has_the_requested_size_and_brightens_with_exposure() {
     assert!(means[1] > means[0] * 1.3, "means {means:?}");
     assert!(means[0] > 1.0, "the mesh is visible: {means:?}");
 }
+
+#[test]
+fn a_z_up_copy_with_up_axis_z_gets_the_colours_of_the_y_up_original() {
+    use crate::commands::up_axis::UpAxis;
+    let dir = tempfile::tempdir().unwrap();
+    let input = fold_obj(dir.path());
+    // The same fold authored Z-up: (x, y, z) → (x, −z, y), a quarter turn about +X.
+    let text = std::fs::read_to_string(&input).unwrap();
+    let turned: String = text
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(rest) => {
+                let v: Vec<f32> = rest.split(' ').map(|t| t.parse().unwrap()).collect();
+                format!("v {} {} {}\n", v[0], -v[2], v[1])
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    let z_up = dir.path().join("z_up.obj");
+    std::fs::write(&z_up, turned).unwrap();
+    let colours = |input: &Path, up_axis: UpAxis, name: &str| {
+        let glb = dir.path().join(name);
+        let request = VisibilityRequest {
+            environment: Some(sky()),
+            out: Some(glb.clone()),
+            up_axis,
+            ..request(input.to_owned())
+        };
+        run_visibility(&request, None).unwrap();
+        (glb_attribute(&glb, "COLOR_0"), glb_attribute(&glb, "_AO"))
+    };
+    let (reference, ao) = colours(&input, UpAxis::PosY, "y.glb");
+    let (turned, turned_ao) = colours(&z_up, UpAxis::PosZ, "z.glb");
+    let (lying, _) = colours(&z_up, UpAxis::PosY, "lying.glb");
+    // a_i does not depend on the up axis; the sky's colours follow it to rounding.
+    for (a, b) in ao.iter().zip(&turned_ao) {
+        assert!((a - b).abs() < 1e-5, "a_i {a} vs {b}");
+    }
+    let max_diff = |a: &[f32], b: &[f32]| {
+        a.iter()
+            .zip(b)
+            .map(|(x, y)| (x - y).abs())
+            .fold(0.0f32, f32::max)
+    };
+    assert!(
+        max_diff(&reference, &turned) < 1e-4,
+        "{}",
+        max_diff(&reference, &turned)
+    );
+    // Without --up-axis the sun lights the lying copy from the side: the test is not vacuous.
+    assert!(
+        max_diff(&reference, &lying) > 0.05,
+        "{}",
+        max_diff(&reference, &lying)
+    );
+}

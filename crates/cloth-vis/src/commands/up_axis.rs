@@ -1,0 +1,42 @@
+//! `--up-axis`: assets authored Z-up (Blender, 3ds Max, CAD, the Berkeley garments) lit and
+//! framed as they stand. The environment's zenith (+Y of a lat-long map) and the default camera
+//! up turn onto the input's up axis; the geometry and every per-vertex output stay in the
+//! input's frame, so a_i and M are untouched and only look-ups of the environment change.
+
+/// An input's up axis (`--up-axis`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum UpAxis {
+    /// +X up.
+    #[value(name = "x")]
+    PosX,
+    /// +Y up (the default: glTF, OBJ from most tools, the shared data).
+    #[value(name = "y")]
+    PosY,
+    /// +Z up (Blender, 3ds Max, CAD exports, the Berkeley garments).
+    #[value(name = "z")]
+    PosZ,
+    /// −X up.
+    #[value(name = "-x")]
+    NegX,
+    /// −Y up.
+    #[value(name = "-y")]
+    NegY,
+    /// −Z up.
+    #[value(name = "-z")]
+    NegZ,
+}
+
+/// The rotation taking +Y (the environment's zenith, the default camera up) onto `axis`: a
+/// quarter or half turn about X or Z, so it maps the lightsphere's octahedral directions onto
+/// each other.
+pub fn up_axis_rotation(axis: UpAxis) -> glam::DQuat {
+    use std::f64::consts::{FRAC_PI_2, PI};
+    match axis {
+        UpAxis::PosY => glam::DQuat::IDENTITY,
+        UpAxis::PosZ => glam::DQuat::from_rotation_x(FRAC_PI_2),
+        UpAxis::NegZ => glam::DQuat::from_rotation_x(-FRAC_PI_2),
+        UpAxis::PosX => glam::DQuat::from_rotation_z(-FRAC_PI_2),
+        UpAxis::NegX => glam::DQuat::from_rotation_z(FRAC_PI_2),
+        UpAxis::NegY => glam::DQuat::from_rotation_x(PI),
+    }
+}
