@@ -30,8 +30,8 @@ pub fn check(
         return Err(invalid(
             path,
             format!(
-                "{what} would be {gb:.1} GB in memory and on disk, above the {:.1} GB limit: \
-                 {levers}, or pass --force",
+                "{what} would be {gb:.1} GB in memory and on disk, above the 8 GiB ({:.1} GB) \
+                 limit: {levers}, or pass --force",
                 REFUSE_BYTES as f64 / 1e9
             ),
         ));

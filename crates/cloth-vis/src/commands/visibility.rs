@@ -701,7 +701,7 @@ pub struct VisibilityArgs {
     /// Hide the progress bar over the frames of an animation.
     #[arg(long)]
     quiet: bool,
-    /// Write a --matrix output estimated above 8 GB anyway (one from 1 GB on is announced).
+    /// Write a --matrix output estimated above 8 GiB anyway (one from 1 GiB on is announced).
     #[arg(long)]
     force: bool,
 }
