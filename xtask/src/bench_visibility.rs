@@ -145,44 +145,19 @@ fn ours(case: &Case, repeats: usize) -> anyhow::Result<Ours> {
     })
 }
 
-fn venv(root: &Path) -> anyhow::Result<std::path::PathBuf> {
-    let venv = root.join("target/mitsuba-venv");
-    let python = venv.join("bin/python");
-    let run = |cmd: &mut Command| -> anyhow::Result<()> {
-        let status = cmd
-            .status()
-            .with_context(|| format!("cannot start {cmd:?}"))?;
-        if !status.success() {
-            bail!("{cmd:?} failed with {status}");
-        }
-        Ok(())
-    };
-    if !python.exists() {
-        run(Command::new("python3").args(["-m", "venv"]).arg(&venv))?;
-    }
-    let has = |module: &str| {
-        Command::new(&python)
-            .args(["-c", &format!("import {module}")])
-            .status()
-            .is_ok_and(|s| s.success())
-    };
-    for (module, package) in [
-        ("mitsuba", "mitsuba==3.*"),
-        ("open3d", "open3d"),
-        ("numpy", "numpy"),
-    ] {
-        if !has(module) {
-            run(Command::new(venv.join("bin/pip")).args(["install", "--quiet", package]))?;
-        }
-    }
-    Ok(python)
-}
-
 /// Run the benchmark.
 pub fn run(root: &Path, out: &Path, quick: bool, threads: usize) -> anyhow::Result<()> {
     let dir = root.join("target/bench-visibility");
     std::fs::create_dir_all(&dir)?;
-    let python = venv(root)?;
+    let python = crate::python::venv(
+        root,
+        "mitsuba-venv",
+        &[
+            ("mitsuba", "mitsuba==3.*"),
+            ("open3d", "open3d"),
+            ("numpy", "numpy"),
+        ],
+    )?;
     let mut cases = Vec::new();
     if quick {
         for level in [2, 3] {

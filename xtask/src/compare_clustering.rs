@@ -8,32 +8,16 @@
 use std::path::Path;
 use std::process::Command;
 
-use anyhow::{Context, bail};
-
-fn run(cmd: &mut Command) -> anyhow::Result<()> {
-    let status = cmd
-        .status()
-        .with_context(|| format!("cannot start {cmd:?}"))?;
-    if !status.success() {
-        bail!("{cmd:?} failed with {status}");
-    }
-    Ok(())
-}
+use crate::python::{run, venv};
 
 /// Run the comparison; `quick` uses one seed instead of five.
 pub fn run_comparison(root: &Path, quick: bool) -> anyhow::Result<()> {
     let out = root.join("target/clustering-compare");
-    let venv = root.join("target/sklearn-venv");
-    let python = venv.join("bin/python");
-    if !python.exists() {
-        run(Command::new("python3").args(["-m", "venv"]).arg(&venv))?;
-        run(Command::new(venv.join("bin/pip")).args([
-            "install",
-            "--quiet",
-            "numpy",
-            "scikit-learn",
-        ]))?;
-    }
+    let python = venv(
+        root,
+        "sklearn-venv",
+        &[("numpy", "numpy"), ("sklearn", "scikit-learn")],
+    )?;
     let mut example = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned()));
     example
         .current_dir(root)

@@ -13,17 +13,9 @@
 use std::path::Path;
 use std::process::Command;
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 
-fn run(cmd: &mut Command) -> anyhow::Result<()> {
-    let status = cmd
-        .status()
-        .with_context(|| format!("cannot start {cmd:?}"))?;
-    if !status.success() {
-        bail!("{cmd:?} failed with {status}");
-    }
-    Ok(())
-}
+use crate::python::{run, venv};
 
 /// Run the comparison with the `cloth-vis` binary at `binary` (built in release when `None`).
 pub fn run_comparison(root: &Path, quick: bool, binary: Option<&Path>) -> anyhow::Result<()> {
@@ -34,18 +26,15 @@ pub fn run_comparison(root: &Path, quick: bool, binary: Option<&Path>) -> anyhow
             data.display()
         );
     }
-    let venv = root.join("target/mitsuba-venv");
-    let python = venv.join("bin/python");
-    if !python.exists() {
-        run(Command::new("python3").args(["-m", "venv"]).arg(&venv))?;
-        run(Command::new(venv.join("bin/pip")).args([
-            "install",
-            "--quiet",
-            "mitsuba==3.*",
-            "numpy",
-            "pillow",
-        ]))?;
-    }
+    let python = venv(
+        root,
+        "mitsuba-venv",
+        &[
+            ("mitsuba", "mitsuba==3.*"),
+            ("numpy", "numpy"),
+            ("PIL", "pillow"),
+        ],
+    )?;
     let binary = match binary {
         Some(path) => path.to_owned(),
         None => {

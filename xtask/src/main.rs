@@ -44,6 +44,7 @@
 mod bench_visibility;
 mod compare_clustering;
 mod compare_translucency;
+mod python;
 mod repro_anim_compression;
 mod repro_btf;
 mod repro_hemicube;
