@@ -115,6 +115,11 @@ pub struct CpuParams {
     /// timings); false keeps it up to [`crate::REBUILD_SAH_RATIO`] whatever the clock says —
     /// the same refit/rebuild sequence on every run, for tests and reproducible reports.
     pub refit_timed: bool,
+    /// Occluders farther than this along a ray (world units, measured from the offset ray
+    /// origin) are ignored: the "distance" of Blender's and QtMeshEditor's AO bakers, which
+    /// keeps a room's far walls from darkening an object inside it. `f32::INFINITY` (the
+    /// default) is paper 000's unbounded visibility. Must be > 0 (not NaN).
+    pub max_distance: f32,
 }
 
 impl Default for CpuParams {
@@ -124,6 +129,7 @@ impl Default for CpuParams {
             method: CpuMethod::default(),
             refit: true,
             refit_timed: true,
+            max_distance: f32::INFINITY,
         }
     }
 }
@@ -146,6 +152,28 @@ impl CpuParams {
     pub fn with_refit_timed(mut self, timed: bool) -> Self {
         self.refit_timed = timed;
         self
+    }
+
+    /// The same parameters with occluders beyond `distance` ignored ([`CpuParams::max_distance`]).
+    pub fn with_max_distance(mut self, distance: f32) -> Self {
+        self.max_distance = distance;
+        self
+    }
+
+    /// Checks [`CpuParams::max_distance`].
+    ///
+    /// # Errors
+    /// [`OcclusionError::InvalidParameter`] when it is NaN or not > 0.
+    pub(crate) fn validate(&self) -> Result<(), crate::OcclusionError> {
+        if self.max_distance > 0.0 {
+            Ok(())
+        } else {
+            Err(crate::OcclusionError::InvalidParameter {
+                what: "max_distance",
+                value: f64::from(self.max_distance),
+                expected: "> 0 (f32::INFINITY: no limit)",
+            })
+        }
     }
 }
 
@@ -283,25 +311,30 @@ pub(crate) fn compute_columns(
     if columns.is_empty() {
         return 0;
     }
-    let offset = params.offset_relative * prepared.diagonal;
+    let span = RaySpan {
+        offset: params.offset_relative * prepared.diagonal,
+        max_t: params.max_distance,
+    };
     let dirs: Vec<Vec3A> = directions.iter().map(|&d| d.into()).collect();
     match &tracer.kind {
         TracerKind::Packets(t) => {
-            packet_columns(prepared, t, &dirs, columns, offset, bits, words_per_row)
+            packet_columns(prepared, t, &dirs, columns, span, bits, words_per_row)
         }
-        TracerKind::Fans(t) => fan_columns(
-            prepared,
-            t,
-            directions,
-            columns,
-            offset,
-            bits,
-            words_per_row,
-        ),
+        TracerKind::Fans(t) => {
+            fan_columns(prepared, t, directions, columns, span, bits, words_per_row)
+        }
         TracerKind::SingleRays(t) => {
-            bvh_columns(prepared, t, &dirs, columns, offset, bits, words_per_row)
+            bvh_columns(prepared, t, &dirs, columns, span, bits, words_per_row)
         }
     }
+}
+
+/// Where every ray of a call starts and ends: origins pushed `offset` along the normal, hits
+/// counted for 0 < t < `max_t`.
+#[derive(Clone, Copy, Debug)]
+struct RaySpan {
+    offset: f32,
+    max_t: f32,
 }
 
 /// A BVH over a scene's triangles, with the geometry it was built for so that it is reused
@@ -410,8 +443,15 @@ impl PacketTracer {
         )
     }
 
-    /// The rays of `mask` (bit r: ray from `origins[r]` towards `direction`) that escape.
-    fn unoccluded(&self, origins: &[Vec3A; PACKET], direction: Vec3A, mask: u64) -> u64 {
+    /// The rays of `mask` (bit r: ray from `origins[r]` towards `direction`) that meet no
+    /// triangle before `max_t`.
+    fn unoccluded(
+        &self,
+        origins: &[Vec3A; PACKET],
+        direction: Vec3A,
+        mask: u64,
+        max_t: f32,
+    ) -> u64 {
         if self.nodes.is_empty() || mask == 0 {
             return mask;
         }
@@ -473,7 +513,7 @@ impl PacketTracer {
                     left &= left - 1;
                     if tris
                         .iter()
-                        .any(|t| t.intersect(origins[r], direction) < f32::INFINITY)
+                        .any(|t| t.intersect(origins[r], direction) < max_t)
                     {
                         visible &= !(1 << r);
                     }
@@ -507,7 +547,7 @@ fn packet_columns(
     tracer: &PacketTracer,
     dirs: &[Vec3A],
     columns: Range<usize>,
-    offset: f32,
+    span: RaySpan,
     bits: &mut [u32],
     words_per_row: usize,
 ) -> u64 {
@@ -519,7 +559,7 @@ fn packet_columns(
             let mut origins = [Vec3A::ZERO; PACKET];
             let mut normals = [Vec3A::ZERO; PACKET];
             for (r, &row) in rows.iter().enumerate() {
-                if let Some((o, n)) = ray_origin(prepared, row as usize, offset) {
+                if let Some((o, n)) = ray_origin(prepared, row as usize, span.offset) {
                     origins[r] = o;
                     normals[r] = n;
                 }
@@ -534,7 +574,7 @@ fn packet_columns(
                     }
                 }
                 rays += u64::from(mask.count_ones());
-                let mut visible = tracer.unoccluded(&origins, direction, mask);
+                let mut visible = tracer.unoccluded(&origins, direction, mask, span.max_t);
                 while visible != 0 {
                     let r = visible.trailing_zeros() as usize;
                     visible &= visible - 1;
@@ -564,7 +604,7 @@ fn bvh_columns(
     tracer: &CpuTracer,
     dirs: &[Vec3A],
     columns: Range<usize>,
-    offset: f32,
+    span: RaySpan,
     bits: &mut [u32],
     words_per_row: usize,
 ) -> u64 {
@@ -577,7 +617,7 @@ fn bvh_columns(
             let mut rays = 0u64;
             let origins: Vec<Option<(Vec3A, Vec3A)>> = rows
                 .iter()
-                .map(|&row| ray_origin(prepared, row as usize, offset))
+                .map(|&row| ray_origin(prepared, row as usize, span.offset))
                 .collect();
             for (origin, out_row) in origins.iter().zip(out.chunks_exact_mut(words_per_row)) {
                 let Some((origin, normal)) = *origin else {
@@ -589,7 +629,7 @@ fn bvh_columns(
                         continue;
                     }
                     rays += 1;
-                    if tracer.unoccluded_cached(origin, direction, f32::INFINITY, &mut cache[j]) {
+                    if tracer.unoccluded_cached(origin, direction, span.max_t, &mut cache[j]) {
                         out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
                     }
                 }
@@ -608,7 +648,7 @@ fn fan_columns(
     tracer: &FanTracer,
     directions: &[Vec3],
     columns: Range<usize>,
-    offset: f32,
+    span: RaySpan,
     bits: &mut [u32],
     words_per_row: usize,
 ) -> u64 {
@@ -622,13 +662,13 @@ fn fan_columns(
             let mut out = vec![0u32; rows.len() * words_per_row];
             let mut rays = 0u64;
             for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
-                let Some((origin, normal)) = ray_origin(prepared, row as usize, offset) else {
+                let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
                     continue;
                 };
                 for (group, fan) in groups.iter().zip(&fans) {
                     let mask = fan.facing(normal.into());
                     rays += u64::from(mask.count_ones());
-                    let mut open = tracer.unoccluded(origin, fan, mask, f32::INFINITY);
+                    let mut open = tracer.unoccluded(origin, fan, mask, span.max_t);
                     while open != 0 {
                         let j = columns.start + group[open.trailing_zeros() as usize] as usize;
                         open &= open - 1;

@@ -446,6 +446,16 @@ impl VisibilityEngine {
     ) -> Result<(), OcclusionError> {
         let k = matrix.directions_len();
         self.last_rays = 0;
+        self.params.cpu.validate()?;
+        let max_distance = self.params.cpu.max_distance;
+        if max_distance.is_finite() && !matches!(self.state, State::Cpu { .. }) {
+            return Err(OcclusionError::InvalidParameter {
+                what: "max_distance",
+                value: f64::from(max_distance),
+                expected: "infinite on the depth and query backends (only the cpu backend \
+                           bounds its rays)",
+            });
+        }
         if first_new >= k {
             return Ok(());
         }

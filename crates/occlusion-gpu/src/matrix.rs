@@ -163,6 +163,26 @@ impl VisibilityMatrix {
             .collect()
     }
 
+    /// Bent normals: the mean unoccluded direction, cosine-weighted as the ambient term is,
+    /// b_i = normalize(Σ_j ω_j M_ij l_j), accumulated in f64 — what AO bakers (Blender,
+    /// xNormal, Substance) write beside AO for shading with a shifted normal. A vertex that
+    /// sees no direction keeps its normal; a vertex used by no triangle gets zero.
+    pub fn bent_normals(&self) -> Vec<Vec3> {
+        (0..self.rows)
+            .map(|i| {
+                let n = self.normals[i];
+                let sum: DVec3 = self
+                    .visible_columns(i)
+                    .map(|j| {
+                        let l = self.directions[j].as_dvec3();
+                        l * (self.weights[j] * n.as_dvec3().dot(l))
+                    })
+                    .sum();
+                sum.try_normalize().map_or(n, DVec3::as_vec3)
+            })
+            .collect()
+    }
+
     /// Vertex radiance c_i = Σ_j M_ij I_j (paper 000 §3.3), accumulated in f64. `radiance[j]`
     /// is I_j, e.g. from `lightsphere::Environment::radiance_per_direction`. Vertices with a
     /// zero normal get NaN.

@@ -19,11 +19,75 @@ fn engine() -> VisibilityEngine {
 fn matches_brute_force_on_sphere_over_plane() {
     for method in [CpuMethod::Packets, CpuMethod::SingleRays, CpuMethod::Fans] {
         let params = VisibilityParams::default().with_cpu(CpuParams::default().with_method(method));
-        matches_brute_force(VisibilityEngine::cpu(params), &format!("{method:?}"));
+        matches_brute_force(VisibilityEngine::cpu(params), &format!("{method:?}"), None);
     }
 }
 
-fn matches_brute_force(mut engine: VisibilityEngine, name: &str) {
+/// With `max_distance` = 0.45 (the sphere floats 0.2 above the plane, its far side 1.2), every
+/// method ignores exactly the occluders a brute-force cast bounded at 0.45 ignores.
+#[test]
+fn max_distance_matches_bounded_brute_force() {
+    for method in [CpuMethod::Packets, CpuMethod::SingleRays, CpuMethod::Fans] {
+        let cpu = CpuParams::default()
+            .with_method(method)
+            .with_max_distance(0.45);
+        let engine = VisibilityEngine::cpu(VisibilityParams::default().with_cpu(cpu));
+        matches_brute_force(engine, &format!("{method:?} ≤ 0.45"), Some(0.45));
+    }
+}
+
+/// Below the 0.2 gap between plane and sphere no occluder is near enough: every vertex gets
+/// the open ambient term of its normal; a non-positive or NaN distance is refused.
+#[test]
+fn max_distance_below_the_gap_sees_every_upper_direction() {
+    let scene = sphere_over_plane();
+    let sphere = Lightsphere::new(2).unwrap();
+    let cpu = CpuParams::default().with_max_distance(0.15);
+    let mut engine = VisibilityEngine::cpu(VisibilityParams::default().with_cpu(cpu));
+    let matrix = engine.compute(&scene, &sphere).unwrap();
+    for (a, n) in matrix.ambient().iter().zip(matrix.normals()) {
+        let open = occlusion_gpu::clamp_ambient(open_ambient(&sphere, n.as_dvec3()) as f32);
+        assert!((a - open).abs() < 1e-6, "a = {a}, open {open} for n {n}");
+    }
+    for bad in [0.0, -1.0, f32::NAN] {
+        let cpu = CpuParams::default().with_max_distance(bad);
+        let mut engine = VisibilityEngine::cpu(VisibilityParams::default().with_cpu(cpu));
+        let error = engine.compute(&scene, &sphere).unwrap_err();
+        assert!(
+            matches!(
+                error,
+                OcclusionError::InvalidParameter {
+                    what: "max_distance",
+                    ..
+                }
+            ),
+            "{bad}: {error}"
+        );
+    }
+}
+
+/// Bent normals: straight up on the open plane far from the sphere (the lightsphere is
+/// symmetric about +Y), tilted away from the sphere beside it, the normal itself on the
+/// sphere's open top.
+#[test]
+fn bent_normals_lean_away_from_occluders() {
+    let scene = sphere_over_plane();
+    let sphere = Lightsphere::new(3).unwrap();
+    let matrix = engine().compute(&scene, &sphere).unwrap();
+    let bent = matrix.bent_normals();
+    // Grid 24×24 over [-2, 2]²: vertex (0, 0) is a corner at (-2, 0, -2), far from the sphere
+    // low directions towards the sphere still meet it: within 8° of +Y.
+    assert!(bent[0].dot(Vec3::Y) > 0.99, "corner: {}", bent[0]);
+    // Vertex (12, 15): x = 0, z = 0.5, beside the sphere: leans to +z (away from it).
+    let beside = bent[15 * 25 + 12];
+    assert!(beside.z > 0.2 && beside.y > 0.0, "beside: {beside}");
+    assert!((beside.length() - 1.0).abs() < 1e-5);
+    for (b, n) in bent.iter().zip(matrix.normals()) {
+        assert!(b.dot(*n) > 0.0 || *b == *n, "bent {b} behind n {n}");
+    }
+}
+
+fn matches_brute_force(mut engine: VisibilityEngine, name: &str, max_t: Option<f64>) {
     let scene = sphere_over_plane();
     let sphere = Lightsphere::new(2).unwrap();
     let matrix = engine.compute(&scene, &sphere).unwrap();
@@ -44,8 +108,10 @@ fn matches_brute_force(mut engine: VisibilityEngine, name: &str) {
     let mut disagreements = 0;
     for (i, (p, n)) in positions.iter().zip(&normals).enumerate() {
         for (j, l) in sphere.directions_f64().iter().enumerate() {
-            let expected =
-                n.dot(*l) > 0.0 && !brute_force_hit(&positions, &triangles, *p + *n * offset, *l);
+            let origin = *p + *n * offset;
+            let bound = max_t.unwrap_or(f64::INFINITY);
+            let expected = n.dot(*l) > 0.0
+                && !brute_force_hit_within(&positions, &triangles, origin, *l, bound);
             // n·l within f32 rounding of 0 may be culled either way (M_ij ≈ 0 regardless).
             let grazing = n.dot(*l).abs() < 1e-6;
             if matrix.is_visible(i, j) != expected && !grazing {

@@ -129,6 +129,17 @@ pub fn brute_force_hit(
     origin: DVec3,
     dir: DVec3,
 ) -> bool {
+    brute_force_hit_within(positions, triangles, origin, dir, f64::INFINITY)
+}
+
+/// [`brute_force_hit`] counting only hits at 0 < t < `max_t` (`dir` unit: t is a distance).
+pub fn brute_force_hit_within(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    origin: DVec3,
+    dir: DVec3,
+    max_t: f64,
+) -> bool {
     triangles.iter().any(|t| {
         let [a, b, c] = t.map(|i| positions[i as usize]);
         let (e1, e2) = (b - a, c - a);
@@ -142,7 +153,7 @@ pub fn brute_force_hit(
         let q = s.cross(e1);
         let v = dir.dot(q) / det;
         let t = e2.dot(q) / det;
-        u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0
+        u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0 && t < max_t
     })
 }
 
