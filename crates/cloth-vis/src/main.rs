@@ -34,6 +34,9 @@ enum Command {
     },
     /// Visibility matrix M and ambient term a_i of a mesh or an animation (paper 000).
     Visibility(commands::visibility::VisibilityArgs),
+    /// Bake ambient occlusion (and radiance, bent normals) into your own .glb/.gltf/.obj/.ply:
+    /// the asset with everything it had, plus linear vertex colour.
+    Bake(commands::bake::BakeArgs),
     /// Static self-shadowing from per-vertex visibility maps: hemicube, single plane or
     /// hemisphere, under an environment and point lights (thesis §4.3).
     Hemicube(commands::hemicube::HemicubeArgs),
@@ -63,6 +66,7 @@ fn main() -> ExitCode {
         Command::Anim { command } => command.run(),
         Command::Btf { command } => command.run(),
         Command::Visibility(args) => args.run(),
+        Command::Bake(args) => args.run(),
         Command::Hemicube(args) => args.run(),
         Command::Shadows(args) => args.run(),
         Command::Sh(args) => args.run(),

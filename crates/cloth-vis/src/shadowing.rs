@@ -8,7 +8,8 @@
 use glam::Vec3;
 use gpu_context::GpuContext;
 use occlusion_gpu::{
-    Backend, DepthParams, SceneObject, VisibilityEngine, VisibilityMatrix, VisibilityParams,
+    Backend, CpuParams, DepthParams, SceneObject, VisibilityEngine, VisibilityMatrix,
+    VisibilityParams,
 };
 use serde_json::json;
 
@@ -55,8 +56,11 @@ impl VisibilityStage {
     /// # Errors
     /// [`Error::Scene`] when the scene asks for a GPU backend and `gpu` is `None`.
     pub fn new(scene: &Scene, gpu: Option<&GpuContext>) -> Result<Self, Error> {
+        let bounded = scene.visibility.max_distance.is_some();
         let backend = match (scene.visibility.backend, gpu) {
             (VisibilityBackendDesc::Cpu, _) => Backend::Cpu,
+            // Only the exact ray caster bounds its rays.
+            (VisibilityBackendDesc::Auto, _) if bounded => Backend::Cpu,
             (VisibilityBackendDesc::Depth, _) => Backend::Depth,
             (VisibilityBackendDesc::Query, _) => Backend::Query,
             (VisibilityBackendDesc::Auto, Some(g)) if !g.summary().is_software => Backend::Depth,
@@ -64,7 +68,11 @@ impl VisibilityStage {
         };
         let depth_resolution = scene.visibility.depth_resolution;
         let params = VisibilityParams::default()
-            .with_depth(DepthParams::default().with_resolution(depth_resolution));
+            .with_depth(DepthParams::default().with_resolution(depth_resolution))
+            .with_cpu(
+                CpuParams::default()
+                    .with_max_distance(scene.visibility.max_distance.unwrap_or(f32::INFINITY)),
+            );
         let engine = match (backend, gpu) {
             (Backend::Cpu, _) => VisibilityEngine::cpu(params),
             (other, Some(g)) => VisibilityEngine::with_gpu(&g.device, &g.queue, other, params),

@@ -87,3 +87,49 @@ fn constant_sky_gives_albedo_times_radiance_times_ambient_on_both_sides() {
     );
     assert!(bottom[centre] > 0.95, "underside {}", bottom[centre]);
 }
+
+/// `[visibility] max_distance` below the roof's height leaves the floor as open as without the
+/// roof (the cpu stage, no GPU needed); a non-positive distance or a GPU backend is refused.
+#[test]
+fn max_distance_below_the_roof_ignores_it() {
+    let sphere = lightsphere::Lightsphere::new(2).unwrap();
+    let ambient = |toml: &str, objects: &[cloth_vis::object::WorldObject]| {
+        let scene = Scene::from_toml(toml, ".".as_ref(), "test").unwrap();
+        let mut stage = cloth_vis::shadowing::VisibilityStage::new(&scene, None).unwrap();
+        stage
+            .compute(objects, &sphere)
+            .unwrap()
+            .0
+            .matrix()
+            .ambient()
+    };
+    let floor = object("floor", sheet(9, 2.0, 0.0), false);
+    let roof = object("roof", sheet(3, 0.8, 0.3), false);
+    let both = [floor.clone(), roof];
+    let alone = ambient(
+        "[visibility]\nbackend = \"cpu\"\n",
+        std::slice::from_ref(&floor),
+    );
+    let bounded = ambient("[visibility]\nmax_distance = 0.25\n", &both);
+    let unbounded = ambient("[visibility]\nbackend = \"cpu\"\n", &both);
+    let n = alone.len();
+    assert_eq!(bounded[..n], alone[..]);
+    assert_ne!(
+        unbounded[..n],
+        alone[..],
+        "the roof shades the floor without the bound"
+    );
+    for bad in [
+        "[visibility]\nmax_distance = 0.0\n",
+        "[visibility]\nmax_distance = -1.0\n",
+        "[visibility]\nbackend = \"depth\"\nmax_distance = 1.0\n",
+    ] {
+        let toml = format!("{bad}[[object]]\nname = \"c\"\nsource = \"synth:cloth\"\n");
+        let scene = Scene::from_toml(&toml, ".".as_ref(), "test").unwrap();
+        let error = scene.validate().unwrap_err();
+        assert!(
+            error.to_string().contains("visibility.max_distance"),
+            "{bad}: {error}"
+        );
+    }
+}

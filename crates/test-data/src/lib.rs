@@ -93,3 +93,61 @@ pub fn make_fifo(path: &std::path::Path) {
         .expect("mkfifo runs");
     assert!(status.success(), "mkfifo {} failed", path.display());
 }
+
+/// Environment variable naming the `node_modules` folder that holds the npm package
+/// `gltf-validator` (default: `<workspace>/target/gltf-validator/node_modules`, where `.ci/run`
+/// installs it with `npm install --prefix target/gltf-validator gltf-validator`).
+pub const GLTF_VALIDATOR_ENV: &str = "GLTF_VALIDATOR_MODULES";
+
+/// The Khronos glTF validator's verdict on a file.
+#[derive(Clone, Debug)]
+pub struct GltfValidation {
+    /// Whether it reported no error.
+    pub ok: bool,
+    /// Its one-line JSON summary: `{"errors":…,"warnings":…,"infos":…,"hints":…,"messages":[…]}`.
+    pub summary: String,
+}
+
+/// Runs the Khronos glTF validator (node + the npm package `gltf-validator`) on `path`.
+///
+/// # Panics
+/// When node or the package is missing and [`in_ci`] is true (through [`skip`]), or when node
+/// cannot run the validator at all. Otherwise a missing validator prints a warning and returns
+/// `None`.
+#[track_caller]
+pub fn validate_gltf(path: &std::path::Path) -> Option<GltfValidation> {
+    let modules = std::env::var(GLTF_VALIDATOR_ENV).map_or_else(
+        |_| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../target/gltf-validator/node_modules")
+        },
+        PathBuf::from,
+    );
+    if !modules.join("gltf-validator").is_dir() {
+        return skip(&format!(
+            "the glTF validator is not installed in {} (npm install --prefix target/gltf-validator gltf-validator)",
+            modules.display()
+        ));
+    }
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("js/validate-gltf.cjs");
+    let output = match std::process::Command::new("node")
+        .arg(&script)
+        .arg(path)
+        .env("NODE_PATH", &modules)
+        .output()
+    {
+        Ok(output) => output,
+        Err(e) => return skip(&format!("node cannot run ({e}); install Node.js")),
+    };
+    let summary = String::from_utf8_lossy(&output.stdout).trim().to_owned();
+    assert!(
+        matches!(output.status.code(), Some(0 | 1)),
+        "the validator failed on {}: {}",
+        path.display(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    Some(GltfValidation {
+        ok: output.status.success(),
+        summary,
+    })
+}

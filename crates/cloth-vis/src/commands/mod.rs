@@ -3,6 +3,7 @@
 //! flags into requests, check them before any work, and print one summary line.
 
 pub mod anim;
+pub mod bake;
 pub mod btf;
 pub mod cpca;
 mod cpca_bits;

@@ -411,12 +411,10 @@ pub fn run_visibility(
     let mut stage = VisibilityStage::new(&scene, gpu).map_err(|e| invalid(input, e.to_string()))?;
     // Rotating the environment turns its backdrop and its I_j alike; M is computed once.
     // With another up axis the zenith turns onto it and --env-rotation turns about it.
-    let environment = request.environment.clone().map(|env| {
-        let up = up_axis_rotation(request.up_axis).as_quat();
-        let world_from_env =
-            up * environment_rotation(request.env_rotation_deg) * env.world_from_env();
-        env.with_rotation(world_from_env)
-    });
+    let environment = request
+        .environment
+        .clone()
+        .map(|env| turned_environment(env, request.up_axis, request.env_rotation_deg));
     let light = match &environment {
         Some(env) => Some(cloth_vis::inputs::light_directions(&scene, env)?.0.1),
         None => None,
@@ -709,16 +707,7 @@ pub struct VisibilityArgs {
 impl VisibilityArgs {
     /// Load the environment the flags name, compute, write; print the summary line.
     pub fn run(self) -> anyhow::Result<()> {
-        let environment = match (&self.env, self.sky) {
-            (Some(path), _) => Some(lightsphere::Environment::load(path)?),
-            (None, true) => {
-                let s = synth::sky(&synth::SkyParams::default())?;
-                Some(lightsphere::Environment::from_latlong(
-                    s.width, s.height, s.texels,
-                )?)
-            }
-            (None, false) => None,
-        };
+        let environment = load_environment(self.env.as_deref(), self.sky)?;
         let backend = self.backend.as_deref().map(|b| match b {
             "cpu" => Backend::Cpu,
             "query" => Backend::Query,
@@ -756,6 +745,34 @@ impl VisibilityArgs {
         };
         super::print_line(&run_visibility(&request, gpu.as_ref())?.line())
     }
+}
+
+/// `--env FILE` or `--sky` (the procedural sky), or no environment.
+pub(super) fn load_environment(
+    env: Option<&Path>,
+    sky: bool,
+) -> Result<Option<lightsphere::Environment>, Error> {
+    Ok(match (env, sky) {
+        (Some(path), _) => Some(lightsphere::Environment::load(path)?),
+        (None, true) => {
+            let s = synth::sky(&synth::SkyParams::default())?;
+            Some(lightsphere::Environment::from_latlong(
+                s.width, s.height, s.texels,
+            )?)
+        }
+        (None, false) => None,
+    })
+}
+
+/// `env` turned by `--env-rotation` about +Y, then with its zenith onto `--up-axis`.
+pub(super) fn turned_environment(
+    env: lightsphere::Environment,
+    up_axis: UpAxis,
+    rotation_deg: f32,
+) -> lightsphere::Environment {
+    let up = up_axis_rotation(up_axis).as_quat();
+    let world_from_env = up * environment_rotation(rotation_deg) * env.world_from_env();
+    env.with_rotation(world_from_env)
 }
 
 /// The sidecars of `--matrix` output `path`: STEM.directions.npy and STEM.weights.npy.

@@ -246,6 +246,10 @@ pub struct VisibilityDesc {
     /// Depth-map side for the `depth` backend.
     #[serde(default = "default_depth_resolution")]
     pub depth_resolution: u32,
+    /// Occluders farther than this along a ray are ignored (world units; `cpu` backend only;
+    /// unset: unbounded, paper 000's visibility).
+    #[serde(default)]
+    pub max_distance: Option<f32>,
 }
 
 fn default_depth_resolution() -> u32 {
@@ -257,6 +261,7 @@ impl Default for VisibilityDesc {
         Self {
             backend: VisibilityBackendDesc::default(),
             depth_resolution: default_depth_resolution(),
+            max_distance: None,
         }
     }
 }
@@ -628,6 +633,16 @@ impl Scene {
                 "visibility.depth_resolution",
                 format!("{res} is outside 16..=16384"),
             ));
+        }
+        if let Some(d) = self.visibility.max_distance {
+            let cpu = !matches!(
+                self.visibility.backend,
+                VisibilityBackendDesc::Depth | VisibilityBackendDesc::Query
+            );
+            if !(d.is_finite() && d > 0.0 && cpu) {
+                let why = "must be finite and > 0, on the cpu backend (the only one bounding rays)";
+                return Err(self.invalid("visibility.max_distance", format!("{d} {why}")));
+            }
         }
         if let Some(EnvironmentSource::File(path)) = self.environment_source()? {
             if !path.exists() {

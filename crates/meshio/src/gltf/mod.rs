@@ -13,6 +13,7 @@
 //! sampled), frames evaluated in parallel.
 
 mod accessor;
+mod augment;
 mod pose;
 mod rig;
 mod sampler;
@@ -25,6 +26,9 @@ use std::path::Path;
 use rayon::prelude::*;
 
 pub use accessor::MAX_VIEWLESS_ELEMENTS;
+pub use augment::{
+    BakeValues, ColourChannel, DoubleSided, GltfBake, GltfBakeReport, write_gltf_with,
+};
 use rig::Rig;
 use sampler::Clip;
 use source::GltfSource;

@@ -208,7 +208,12 @@ fn validate(path: &Path, root: &gltf::json::Root) -> Result<(), MeshIoError> {
 
 /// Loads a buffer URI: a base64 `data:` URI (bounded by the document's own size) or a path
 /// relative to the document that stays inside its folder.
-fn read_uri(path: &Path, base: &Path, element: &str, uri: &str) -> Result<Vec<u8>, MeshIoError> {
+pub(super) fn read_uri(
+    path: &Path,
+    base: &Path,
+    element: &str,
+    uri: &str,
+) -> Result<Vec<u8>, MeshIoError> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let Some((_, payload)) = rest.split_once(";base64,") else {
             return Err(gltf_error(

@@ -6,6 +6,7 @@ mod common;
 mod anim_compress;
 mod anim_jumpmap;
 mod anim_search;
+mod bake_cmd;
 mod hemicube_cmd;
 mod inspect_cmd;
 mod render_outputs;

@@ -1,0 +1,370 @@
+//! `cloth-vis bake`: ambient occlusion (and radiance, bent normals) baked into the user's own
+//! asset — the input with everything it had, plus per-vertex attributes (issue #18 item 1).
+//!
+//! The values are paper 000's: a_i = (1/π) Σ_j ω_j M_ij over the lightsphere of `--level`
+//! (the same engine and parameters as `cloth-vis visibility`, so COLOR_0 equals its a_i on the
+//! same mesh), computed on the asset **as written** (a glTF in its rest pose: node transforms,
+//! default morph weights and skins evaluated without an animation; `visibility` poses an
+//! animated glTF at frame 0 of its first clip instead).
+//!
+//! Outputs by the input's kind:
+//! - `.glb`/`.gltf` → `.glb` ([`meshio::write_gltf_with`]): every node, mesh, material, texture,
+//!   skin, animation and extension kept, buffers and images embedded byte for byte; a_i as
+//!   **linear** vertex colour in the chosen channel (`COLOR_0` RGB by default, `COLOR_0.a` over
+//!   the existing colour, or `COLOR_1`), `_RADIANCE` (`VEC3` float, unclamped, a white
+//!   Lambertian surface: c_i = (1/π) Σ_j M_ij I_j ω_j) under `--env`/`--sky`, `_BENT_NORMAL`
+//!   with `--bent-normals`; materials double-sided per `--two-sided` (auto: primitives with a
+//!   border edge, i.e. open surfaces such as cloth); primitives without a material get a
+//!   non-metallic rough one.
+//! - `.obj` → `.obj`: the file's lines unchanged except each `v x y z` line, which gets the
+//!   linear colour `r g b` = (a_i, a_i, a_i) (the extension Blender, MeshLab and trimesh read).
+//! - `.ply` → `.ply`: positions, normals, 8-bit linear colour and a float `ao` (other vertex
+//!   properties of the input are not carried).
+//!
+//! Vertices used by no face get a_i = 1 in colours (NaN in the PLY's `ao`) and zero radiance.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use cloth_vis::Error;
+use cloth_vis::lighting::shadowed_radiance;
+use cloth_vis::object::WorldObject;
+use cloth_vis::scene::{Scene, VisibilityBackendDesc};
+use cloth_vis::shadowing::VisibilityStage;
+use glam::Vec3;
+use meshio::{BakeValues, ColourChannel, DoubleSided, GltfBake};
+
+use super::invalid;
+use super::up_axis::UpAxis;
+use super::visibility::{load_environment, lower_extension, turned_environment};
+
+/// What the input and output extensions ask for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Gltf,
+    Obj,
+    Ply,
+}
+
+/// `--two-sided`: which materials become double-sided.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TwoSided {
+    /// Materials of open surfaces (a border edge): cloth, leaves, planes.
+    Auto,
+    /// Every baked material.
+    On,
+    /// Leave `doubleSided` as the input has it.
+    Off,
+}
+
+/// `cloth-vis bake`: the flags.
+#[derive(clap::Args)]
+pub struct BakeArgs {
+    /// The asset: .glb, .gltf, .obj or .ply.
+    input: PathBuf,
+    /// Output: .glb for a glTF input, .obj for an OBJ, .ply for a PLY.
+    #[arg(long)]
+    out: PathBuf,
+    /// Lightsphere level s (k = 2 + 4^(s+1) directions), as for `visibility`.
+    #[arg(long, default_value_t = 3)]
+    level: u32,
+    /// Backend: cpu (exact rays), depth or query (GPU); default as for `visibility`.
+    #[arg(long, value_parser = ["depth", "query", "cpu"])]
+    backend: Option<String>,
+    /// Occluders farther than D (the asset's units) are ignored (cpu backend).
+    #[arg(long, value_name = "D")]
+    max_distance: Option<f32>,
+    /// Where a_i goes in a glTF: COLOR_0 (RGB), COLOR_0.a (alpha over the existing colour) or
+    /// COLOR_1.
+    #[arg(long, default_value = "COLOR_0", value_parser = ["COLOR_0", "COLOR_0.a", "COLOR_1"])]
+    channel: String,
+    /// Materials set double-sided: auto (open surfaces), on (all), off (as in the input).
+    #[arg(long, value_enum, default_value = "auto")]
+    two_sided: TwoSided,
+    /// Also write `_BENT_NORMAL` (glTF): the cosine-weighted mean open direction.
+    #[arg(long)]
+    bent_normals: bool,
+    /// HDR environment (.hdr/.exr): also write `_RADIANCE` (glTF), unclamped.
+    #[arg(long, conflicts_with = "sky")]
+    env: Option<PathBuf>,
+    /// The procedural sky as the environment (see --env).
+    #[arg(long)]
+    sky: bool,
+    /// Rotate the environment by DEG degrees about the up axis.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    env_rotation: f32,
+    /// The input's up axis (the environment's zenith turns onto it).
+    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
+    up_axis: UpAxis,
+}
+
+/// What was baked, for the summary line.
+#[derive(Clone, Debug)]
+pub struct BakeSummary {
+    /// Vertices baked.
+    pub vertices: usize,
+    /// Light directions.
+    pub directions: usize,
+    /// Visibility time (ms).
+    pub millis: f64,
+    /// The glTF writer's report (glTF outputs).
+    pub gltf: Option<meshio::GltfBakeReport>,
+}
+
+impl BakeArgs {
+    /// Bake and print one summary line.
+    pub fn run(self) -> anyhow::Result<()> {
+        let summary = bake(&self)?;
+        let mut line = format!(
+            "bake: a_i of {} vertices over {} directions in {:.1} ms -> {}",
+            summary.vertices,
+            summary.directions,
+            summary.millis,
+            self.out.display()
+        );
+        if let Some(r) = &summary.gltf {
+            line.push_str(&format!(
+                " ({} primitive(s); {} mesh(es) duplicated for instances; {} image(s) embedded; \
+                 {} material(s) double-sided{}{})",
+                r.primitives,
+                r.meshes_duplicated,
+                r.images_embedded,
+                r.materials_double_sided,
+                if r.default_material_added {
+                    "; a default material added"
+                } else {
+                    ""
+                },
+                if r.colours_replaced > 0 {
+                    "; an existing COLOR_0 replaced"
+                } else {
+                    ""
+                },
+            ));
+        }
+        super::print_line(&line)
+    }
+}
+
+fn kind_of(path: &Path, what: &str) -> Result<Kind, Error> {
+    match lower_extension(path).as_deref() {
+        Some("glb" | "gltf") => Ok(Kind::Gltf),
+        Some("obj") => Ok(Kind::Obj),
+        Some("ply") => Ok(Kind::Ply),
+        _ => Err(invalid(
+            path,
+            format!(
+                "{what} must be .glb, .gltf, .obj or .ply (animations: see `visibility --frames`)"
+            ),
+        )),
+    }
+}
+
+/// Computes and writes the bake `args` asks for.
+///
+/// # Errors
+/// Flag, loader, engine and writer errors, naming the file; refused before any work: an output
+/// whose kind does not match the input's, an output equal to the input, a bad distance.
+pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
+    let input = &args.input;
+    super::refuse_overwriting_input(&args.out, &[input])?;
+    let kind = kind_of(input, "the input")?;
+    let wanted = match kind {
+        Kind::Gltf => "glb",
+        Kind::Obj => "obj",
+        Kind::Ply => "ply",
+    };
+    if lower_extension(&args.out).as_deref() != Some(wanted) {
+        return Err(invalid(
+            &args.out,
+            format!(
+                "--out must be a .{wanted} for this input (the input's kind, its content kept)"
+            ),
+        ));
+    }
+    let mut scene = Scene::one_object(input, "cloth-vis bake")?;
+    scene.lighting.level = args.level;
+    scene.visibility.backend = match args.backend.as_deref() {
+        Some("cpu") => VisibilityBackendDesc::Cpu,
+        Some("depth") => VisibilityBackendDesc::Depth,
+        Some("query") => VisibilityBackendDesc::Query,
+        _ => VisibilityBackendDesc::Auto,
+    };
+    if let Some(d) = args.max_distance {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(invalid(
+                input,
+                format!("--max-distance {d} must be finite and > 0"),
+            ));
+        }
+        if matches!(args.backend.as_deref(), Some("depth" | "query")) {
+            return Err(invalid(
+                input,
+                "--max-distance needs the cpu backend (exact rays)".into(),
+            ));
+        }
+    }
+    scene.visibility.max_distance = args.max_distance;
+    let environment = load_environment(args.env.as_deref(), args.sky)?
+        .map(|env| turned_environment(env, args.up_axis, args.env_rotation));
+    let gpu = match scene.visibility.backend {
+        VisibilityBackendDesc::Depth | VisibilityBackendDesc::Query => Some(
+            gpu_context::GpuContext::new(&gpu_context::GpuOptions::default())?,
+        ),
+        VisibilityBackendDesc::Auto if args.max_distance.is_none() => super::optional_gpu(),
+        _ => None,
+    };
+    let sphere = lightsphere::Lightsphere::new(args.level)?;
+    // The asset as written: a glTF's rest pose, not a clip's first frame.
+    let (mesh, _) = meshio::load_mesh(input, &meshio::LoadOptions::default())?;
+    let normals = meshio::compute_normals(
+        &mesh.positions,
+        &mesh.triangles,
+        meshio::NormalWeighting::Angle,
+    );
+    let object = WorldObject {
+        name: scene.name.clone(),
+        positions: mesh.positions.clone(),
+        normals,
+        triangles: mesh.triangles.clone(),
+        uvs: mesh.uvs.clone(),
+        albedo: Vec3::ONE,
+        two_sided: false,
+        front: None,
+        back: None,
+        animation: None,
+    };
+    let mut stage =
+        VisibilityStage::new(&scene, gpu.as_ref()).map_err(|e| invalid(input, e.to_string()))?;
+    let t = Instant::now();
+    let (visibility, _) = stage.compute(std::slice::from_ref(&object), &sphere)?;
+    let millis = t.elapsed().as_secs_f64() * 1e3;
+    let matrix = visibility.matrix();
+    let ambient = matrix.ambient();
+    let finite = |v: Vec3| if v.is_finite() { v } else { Vec3::ZERO };
+    let radiance: Option<Vec<Vec3>> = match &environment {
+        Some(env) => {
+            let light = cloth_vis::inputs::light_directions(&scene, env)?.0.1;
+            Some(
+                shadowed_radiance(matrix, &sphere, &light)?
+                    .into_iter()
+                    .map(finite)
+                    .collect(),
+            )
+        }
+        None => None,
+    };
+    let bent = args.bent_normals.then(|| matrix.bent_normals());
+    let mut gltf = None;
+    match kind {
+        Kind::Gltf => {
+            let channel = match args.channel.as_str() {
+                "COLOR_0.a" => ColourChannel::Color0Alpha,
+                "COLOR_1" => ColourChannel::Color1,
+                _ => ColourChannel::Color0,
+            };
+            let mut attributes = Vec::new();
+            if let Some(r) = &radiance {
+                attributes.push(("_RADIANCE".to_owned(), BakeValues::Vec3(r)));
+            }
+            if let Some(b) = &bent {
+                attributes.push(("_BENT_NORMAL".to_owned(), BakeValues::Vec3(b)));
+            }
+            let request = GltfBake {
+                colour: Some((channel, &ambient)),
+                attributes,
+                double_sided: match args.two_sided {
+                    TwoSided::Auto => DoubleSided::Open,
+                    TwoSided::On => DoubleSided::All,
+                    TwoSided::Off => DoubleSided::Keep,
+                },
+            };
+            gltf = Some(meshio::write_gltf_with(input, &args.out, &request)?);
+        }
+        Kind::Obj => write_obj_colours(input, &args.out, &ambient)?,
+        Kind::Ply => {
+            let colours: Vec<Vec3> = ambient.iter().map(|a| Vec3::splat(linear(*a))).collect();
+            super::visibility::write_ply(
+                &args.out,
+                "cloth-vis bake: linear colour = ao = a_i (NaN: vertex used by no face)",
+                &mesh.positions,
+                matrix.normals(),
+                &mesh.triangles,
+                &colours,
+                &ambient,
+            )?;
+        }
+    }
+    Ok(BakeSummary {
+        vertices: ambient.len(),
+        directions: sphere.len(),
+        millis,
+        gltf,
+    })
+}
+
+/// a_i as a colour value: clamped to [0, 1], 1 where undefined (a vertex used by no face).
+fn linear(a: f32) -> f32 {
+    if a.is_finite() {
+        a.clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
+}
+
+/// Copies the OBJ `input` to `output` with the colour (a, a, a) on each `v` line (replacing
+/// colours already there), every other line byte for byte; written atomically.
+fn write_obj_colours(input: &Path, output: &Path, ambient: &[f32]) -> Result<(), Error> {
+    let bytes = input_guard::read_regular(input).map_err(|e| Error::Io {
+        path: input.to_owned(),
+        reason: e.to_string(),
+    })?;
+    let mut vertex = 0usize;
+    let mut out = Vec::with_capacity(bytes.len() + ambient.len() * 30);
+    for line in bytes.split_inclusive(|b| *b == b'\n') {
+        let ending = line
+            .iter()
+            .rev()
+            .take_while(|b| matches!(b, b'\r' | b'\n'))
+            .count();
+        let (body, ending) = line.split_at(line.len() - ending);
+        let text = String::from_utf8_lossy(body);
+        let mut tokens = text.split_whitespace();
+        if tokens.next() != Some("v") {
+            out.extend_from_slice(line);
+            continue;
+        }
+        let coords: Vec<&str> = tokens.collect();
+        let Some(&a) = ambient.get(vertex) else {
+            return Err(invalid(
+                input,
+                format!(
+                    "has more `v` lines than the {} vertices loaded",
+                    ambient.len()
+                ),
+            ));
+        };
+        vertex += 1;
+        let keep = if coords.len() >= 6 { 3 } else { coords.len() };
+        let a = linear(a);
+        write!(out, "v {} {a} {a} {a}", coords[..keep].join(" ")).expect("writing to a Vec");
+        out.extend_from_slice(ending);
+    }
+    if vertex != ambient.len() {
+        return Err(invalid(
+            input,
+            format!(
+                "has {vertex} `v` lines but {} vertices were loaded",
+                ambient.len()
+            ),
+        ));
+    }
+    atomic_out::write_with(output, |w| w.write_all(&out))?;
+    Ok(())
+}
