@@ -362,3 +362,36 @@ fn single_frame_animation_is_a_static_mesh_and_bad_animations_are_refused() {
         assert!(!bad_path.exists());
     }
 }
+
+/// A 1,000-frame clip: the file is linear in F (under 3× the `.npy` of its positions, which is
+/// 12·N·F bytes: position and normal deltas plus a sparse one-hot weights track; a dense track
+/// would add 4·F·(F − 1) bytes, 4 MB here, and fail the bound), loads back frame for frame, and
+/// the Khronos validator accepts the sparse weights.
+#[test]
+fn thousand_frame_animation_is_linear_in_frames_and_validates() {
+    let frames = 1000;
+    let animation = waving_animation(frames, Vec3::ZERO);
+    let n = animation.vertex_count();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("long.glb");
+    write_glb_animation(&path, &animation).unwrap();
+    let size = std::fs::metadata(&path).unwrap().len() as usize;
+    let npy = 12 * n * frames;
+    assert!(size < 3 * npy, "{size} bytes for a {npy}-byte .npy");
+    assert!(
+        4 * frames * (frames - 1) > npy,
+        "the dense track would break the bound"
+    );
+    let options = AnimationOptions {
+        frame_rate: animation.frame_rate,
+        ..AnimationOptions::default()
+    };
+    let (loaded, _) = load_animation(&path, &options).unwrap();
+    assert_eq!(loaded.frame_count(), frames);
+    for f in [0, 1, 499, 999] {
+        assert_close(&loaded.frames[f], &animation.frames[f], 4.0 * f32::EPSILON);
+    }
+    if let Some(report) = test_data::validate_gltf(&path) {
+        assert!(report.ok, "{}", report.summary);
+    }
+}

@@ -106,9 +106,10 @@ impl Rig {
         let joints = self.joint_matrices(&globals);
         let mut out = Vec::with_capacity(self.vertex_count);
         for (instance, weights) in self.instances.iter().zip(&pose.weights) {
+            let active = active_targets(weights);
             for prim in &instance.primitives {
                 for (v, &p0) in prim.positions.iter().enumerate() {
-                    let p = morph(p0, &prim.morph_positions, weights, v);
+                    let p = morph(p0, &prim.morph_positions, &active, v);
                     out.push(
                         Self::vertex_matrix(instance, prim, &joints, &globals, v)
                             .transform_point3(p),
@@ -128,12 +129,13 @@ impl Rig {
         let joints = self.joint_matrices(&globals);
         let mut out = Vec::with_capacity(self.vertex_count);
         for (instance, weights) in self.instances.iter().zip(&pose.weights) {
+            let active = active_targets(weights);
             for prim in &instance.primitives {
                 let normals = prim.normals.as_ref()?;
                 for (v, &n0) in normals.iter().enumerate() {
                     let mut n = n0;
-                    for (delta, &w) in prim.morph_normals.iter().zip(weights) {
-                        if let Some(delta) = delta {
+                    for &(t, w) in &active {
+                        if let Some(Some(delta)) = prim.morph_normals.get(t) {
                             n += w * delta[v];
                         }
                     }
@@ -170,11 +172,23 @@ impl Rig {
     }
 }
 
-fn morph(p0: Vec3, deltas: &[Vec<Vec3>], weights: &[f32], v: usize) -> Vec3 {
-    deltas
+/// The morph targets with a non-zero weight, in target order: a clip stored as one target per
+/// frame has one of thousands active per pose, and skipping the rest keeps sampling linear in
+/// the frame count. (A zero weight adds exactly nothing: `p + 0·Δ = p` for finite Δ.)
+fn active_targets(weights: &[f32]) -> Vec<(usize, f32)> {
+    weights
         .iter()
-        .zip(weights)
-        .fold(p0, |p, (delta, &w)| p + w * delta[v])
+        .enumerate()
+        .filter(|(_, w)| **w != 0.0)
+        .map(|(t, w)| (t, *w))
+        .collect()
+}
+
+fn morph(p0: Vec3, deltas: &[Vec<Vec3>], active: &[(usize, f32)], v: usize) -> Vec3 {
+    active
+        .iter()
+        .filter_map(|&(t, w)| deltas.get(t).map(|d| (d, w)))
+        .fold(p0, |p, (delta, w)| p + w * delta[v])
 }
 
 #[cfg(test)]

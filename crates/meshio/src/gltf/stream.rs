@@ -16,9 +16,10 @@ use super::write::{
 };
 use crate::{MeshIoError, NormalWeighting, compute_normals};
 
-/// Most frames a `.glb` morph-target animation may hold: the weights clip stores F·(F − 1)
-/// floats (one weight per target per keyframe), 64 MiB at this limit. Longer clips belong in
-/// `.npy` or an OBJ frame folder.
+/// Most frames a `.glb` morph-target animation may hold. The file stores the one-hot weights
+/// track sparsely (linear in F), but readers expand it to F·(F − 1) floats (one weight per
+/// target per keyframe): 64 MiB at this limit. Longer clips belong in `.npy`, an OBJ frame
+/// folder or a vertex-animation texture.
 pub const MAX_GLB_ANIMATION_FRAMES: usize = 4096;
 
 /// Everything of a streamed animation but its frames ([`write_glb_animation_with`]).
@@ -129,16 +130,15 @@ pub fn write_glb_animation_with<E: From<MeshIoError>>(
             for t in keyframe_times(count, clip.frame_rate) {
                 w.write_all(&t.to_le_bytes())?;
             }
-            // Keyframe f's weights: one-hot on target f − 1 (all zero for f = 0).
-            let mut row = vec![0.0f32; count - 1];
-            for f in 0..count {
-                if f >= 1 {
-                    row[f - 1] = 1.0;
-                }
-                write_floats(w, &row)?;
-                if f >= 1 {
-                    row[f - 1] = 0.0;
-                }
+            // Keyframe f's weights: one-hot on target f − 1 (all zero for f = 0), as the
+            // sparse entries (f·T + f − 1, 1.0), T = F − 1 targets.
+            let targets = count - 1;
+            for f in 1..count {
+                let index = u32::try_from(f * targets + f - 1).expect("F ≤ 4096: F² < 2³²");
+                w.write_all(&index.to_le_bytes())?;
+            }
+            for _ in 1..count {
+                w.write_all(&1.0f32.to_le_bytes())?;
             }
         }
         Ok(())
@@ -157,8 +157,8 @@ fn check_clip(path: &Path, clip: &GlbClip<'_>) -> Result<(), MeshIoError> {
             "animation".into(),
             format!(
                 "has {} frames; a .glb morph-target animation holds 1 ..= \
-                 {MAX_GLB_ANIMATION_FRAMES} (MAX_GLB_ANIMATION_FRAMES: its weights grow as \
-                 F²); write .npy or an OBJ frame folder for longer clips",
+                 {MAX_GLB_ANIMATION_FRAMES} (MAX_GLB_ANIMATION_FRAMES: readers expand its \
+                 weights to F² floats); write .npy or an OBJ frame folder for longer clips",
                 clip.frames
             ),
         ));
@@ -280,9 +280,22 @@ impl Layout {
                 .unwrap_or(0.0);
             layout.accessors[input]["min"] = json!([0.0]);
             layout.accessors[input]["max"] = json!([f64::from(last)]);
-            let weights = clip.frames * target_count;
-            let view = layout.view(4 * weights, 0);
-            let output = layout.accessor(view, COMPONENT_FLOAT, weights, "SCALAR");
+            // The weights track is one-hot per keyframe: a sparse accessor (zeros, with a 1
+            // at f·T + f − 1 for f ≥ 1) keeps the file linear in F.
+            let ones = clip.frames - 1;
+            let indices = layout.view(4 * ones, 0);
+            let values = layout.view(4 * ones, 0);
+            layout.accessors.push(json!({
+                "componentType": COMPONENT_FLOAT,
+                "count": clip.frames * target_count,
+                "type": "SCALAR",
+                "sparse": {
+                    "count": ones,
+                    "indices": { "bufferView": indices, "componentType": COMPONENT_UNSIGNED_INT },
+                    "values": { "bufferView": values },
+                },
+            }));
+            let output = layout.accessors.len() - 1;
             layout.animations = Some(json!([{
                 "name": "frames",
                 "samplers": [{ "input": input, "output": output, "interpolation": "STEP" }],

@@ -26,7 +26,9 @@
 //! `STEP` interpolation at keyframe times `t_f = f / frame_rate`, the weights of keyframe f
 //! being one-hot on target f − 1 (all zero for f = 0). [`crate::load_animation`] sampling at the
 //! same frame rate reads back the frames (up to the f32 rounding of `p_0 + (p_f − p_0)`). The
-//! weight output holds F·(F − 1) floats, so this layout suits clips of up to a few thousand
+//! weight output is a sparse accessor (F − 1 ones over F·(F − 1) zeros), so the file grows
+//! linearly with F (≈ 2× the `.npy` of the positions: position and normal deltas); readers
+//! expand the weights to F·(F − 1) floats, so this layout suits clips of up to a few thousand
 //! frames.
 
 use std::io::Write as _;
