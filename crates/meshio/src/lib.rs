@@ -63,6 +63,7 @@ mod report;
 mod text;
 mod types;
 mod validate;
+mod vat;
 
 use std::path::Path;
 
@@ -87,6 +88,9 @@ pub use types::{Animation, Mesh};
 pub use validate::{
     ZERO_AREA_RELATIVE, count_duplicate_positions, find_degenerate_triangles,
     find_unreferenced_vertices,
+};
+pub use vat::{
+    VAT_MAX_HEIGHT, VAT_MAX_WIDTH, VatClip, VatReport, vat_companions, vat_layout, write_vat_with,
 };
 
 /// Lower-case extension of `path` (empty when there is none).

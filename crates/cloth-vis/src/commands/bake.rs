@@ -21,6 +21,11 @@
 //! - `.ply` → `.ply`: positions, normals, 8-bit linear colour and a float `ao` (other vertex
 //!   properties of the input are not carried).
 //!
+//! - `.exr`/`.png` from an animation (a folder of numbered OBJ, an animated glTF with `--clip`, a
+//!   point cache with `--topology`): a vertex-animation texture ([`meshio::write_vat_with`]) of
+//!   every frame, a_i **of that frame** in alpha — per-frame baking of a deforming mesh, one
+//!   engine for all frames (the cpu backend refits its BVH), a progress bar over frames.
+//!
 //! Vertices used by no face get a_i = 1 in colours (NaN in the PLY's `ao`) and zero radiance.
 
 use std::io::Write as _;
@@ -45,6 +50,8 @@ enum Kind {
     Gltf,
     Obj,
     Ply,
+    /// A vertex-animation texture of every frame, a_i in alpha.
+    Vat,
 }
 
 /// `--two-sided`: which materials become double-sided.
@@ -61,9 +68,11 @@ pub enum TwoSided {
 /// `cloth-vis bake`: the flags.
 #[derive(clap::Args)]
 pub struct BakeArgs {
-    /// The asset: .glb, .gltf, .obj or .ply.
+    /// The asset: .glb, .gltf, .obj or .ply; for a .exr/.png output an animation (folder of
+    /// numbered .obj, animated .glb, point cache .npy/.pc2/.mdd with --topology).
     input: PathBuf,
-    /// Output: .glb for a glTF input, .obj for an OBJ, .ply for a PLY.
+    /// Output: .glb for a glTF input, .obj for an OBJ, .ply for a PLY; .exr/.png for a
+    /// vertex-animation texture of an animation with a_i per frame in alpha.
     #[arg(long)]
     out: PathBuf,
     /// Lightsphere level s (k = 2 + 4^(s+1) directions), as for `visibility`.
@@ -102,6 +111,18 @@ pub struct BakeArgs {
     /// The input's up axis (the environment's zenith turns onto it).
     #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
     up_axis: UpAxis,
+    /// A mesh whose triangles a point-cache input (.npy, .pc2, .mdd) takes (VAT output).
+    #[arg(long, value_name = "MESH")]
+    topology: Option<PathBuf>,
+    /// The glTF animation to bake per frame (VAT output), by name or index.
+    #[arg(long, value_name = "NAME|INDEX", value_parser = super::parse::clip)]
+    clip: Option<meshio::ClipSelector>,
+    /// Frames A..B of an animation (VAT output; end exclusive; default all).
+    #[arg(long, value_parser = super::parse::range)]
+    frames: Option<(usize, usize)>,
+    /// Hide the progress bar over frames.
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// What was baked, for the summary line.
@@ -174,13 +195,19 @@ fn kind_of(path: &Path, what: &str) -> Result<Kind, Error> {
 pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
     let input = &args.input;
     super::refuse_overwriting_input(&args.out, &[input])?;
-    let kind = kind_of(input, "the input")?;
+    let vat = super::vat_out::is_vat(&args.out);
+    let kind = if vat {
+        Kind::Vat
+    } else {
+        kind_of(input, "the input")?
+    };
     let wanted = match kind {
         Kind::Gltf => "glb",
         Kind::Obj => "obj",
         Kind::Ply => "ply",
+        Kind::Vat => "exr",
     };
-    if lower_extension(&args.out).as_deref() != Some(wanted) {
+    if !vat && lower_extension(&args.out).as_deref() != Some(wanted) {
         return Err(invalid(
             &args.out,
             format!(
@@ -221,6 +248,11 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         _ => None,
     };
     let sphere = lightsphere::Lightsphere::new(args.level)?;
+    let mut stage =
+        VisibilityStage::new(&scene, gpu.as_ref()).map_err(|e| invalid(input, e.to_string()))?;
+    if vat {
+        return bake_vat(args, &mut stage, &sphere);
+    }
     // The asset as written: a glTF's rest pose, not a clip's first frame.
     let (mesh, _) = meshio::load_mesh(input, &meshio::LoadOptions::default())?;
     let normals = meshio::compute_normals(
@@ -240,8 +272,6 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         back: None,
         animation: None,
     };
-    let mut stage =
-        VisibilityStage::new(&scene, gpu.as_ref()).map_err(|e| invalid(input, e.to_string()))?;
     let t = Instant::now();
     let (visibility, _) = stage.compute(std::slice::from_ref(&object), &sphere)?;
     let millis = t.elapsed().as_secs_f64() * 1e3;
@@ -288,6 +318,7 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
             gltf = Some(meshio::write_gltf_with(input, &args.out, &request)?);
         }
         Kind::Obj => write_obj_colours(input, &args.out, &ambient)?,
+        Kind::Vat => unreachable!("returned above"),
         Kind::Ply => {
             let colours: Vec<Vec3> = ambient.iter().map(|a| Vec3::splat(linear(*a))).collect();
             super::visibility::write_ply(
@@ -306,6 +337,81 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         directions: sphere.len(),
         millis,
         gltf,
+    })
+}
+
+/// Bakes every frame of an animation (or frames `--frames`) into a vertex-animation texture:
+/// positions and normals per frame, a_i of that frame in alpha (#18 item 2); one engine for all
+/// frames, so the cpu backend refits its BVH instead of rebuilding it.
+fn bake_vat(
+    args: &BakeArgs,
+    stage: &mut VisibilityStage,
+    sphere: &lightsphere::Lightsphere,
+) -> Result<BakeSummary, Error> {
+    let input = &args.input;
+    let clip = args.clip.clone().unwrap_or(meshio::ClipSelector::First);
+    let (animation, _) = meshio::load_animation(
+        input,
+        &super::animation_options(&clip, args.topology.as_deref()),
+    )?;
+    let total = animation.frames.len();
+    let (start, end) = args.frames.unwrap_or((0, total));
+    if start >= end || end > total {
+        return Err(invalid(
+            input,
+            format!("--frames {start}..{end} is outside the {total} frames (0..{total})"),
+        ));
+    }
+    let count = end - start;
+    let size = (count, animation.vertex_count());
+    super::vat_out::check(input, &args.out, &animation.triangles, size)?;
+    let bar = cloth_vis::run::progress_bar(!args.quiet && count > 1, count as u64, "frames");
+    let mut millis = 0.0;
+    let mut ambient = Vec::with_capacity(count);
+    for frame in &animation.frames[start..end] {
+        let normals =
+            meshio::compute_normals(frame, &animation.triangles, meshio::NormalWeighting::Angle);
+        let object = WorldObject {
+            name: "bake".to_owned(),
+            positions: frame.clone(),
+            normals,
+            triangles: animation.triangles.clone(),
+            uvs: None,
+            albedo: Vec3::ONE,
+            two_sided: false,
+            front: None,
+            back: None,
+            animation: None,
+        };
+        let t = Instant::now();
+        let (visibility, _) = stage.compute(std::slice::from_ref(&object), sphere)?;
+        millis += t.elapsed().as_secs_f64() * 1e3;
+        ambient.push(visibility.matrix().ambient());
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let vertices = animation.vertex_count();
+    let line = super::vat_out::write(
+        &args.out,
+        &animation.triangles,
+        animation.frame_rate,
+        (count, vertices),
+        |f, p, alpha| {
+            p.copy_from_slice(&animation.frames[start + f]);
+            for (a, v) in alpha.iter_mut().zip(&ambient[f]) {
+                *a = linear(*v);
+            }
+            Ok(())
+        },
+    )?;
+    if !args.quiet {
+        eprintln!("{line}");
+    }
+    Ok(BakeSummary {
+        vertices,
+        directions: sphere.len(),
+        millis,
+        gltf: None,
     })
 }
 

@@ -247,6 +247,8 @@ fn worst_frame(d: &Distortion) -> (usize, f64) {
 enum OutKind {
     Npy,
     Glb,
+    /// A vertex-animation texture (`.exr`, `.png`).
+    Vat,
     /// With what to do about an existing folder.
     ObjFolder(atomic_out::ExistingFolder),
 }
@@ -262,12 +264,14 @@ fn out_kind(out: &Path, force: bool) -> Result<OutKind, Error> {
     {
         Some("npy") => Ok(OutKind::Npy),
         Some("glb") => Ok(OutKind::Glb),
+        Some("exr" | "png") => Ok(OutKind::Vat),
         None => Ok(OutKind::ObjFolder(super::folder_output(out, force)?)),
         Some(other) => Err(invalid(
             out,
             format!(
                 "output extension .{other} is not supported: use .npy ([F, V, 3]), .glb \
-                 (morph-target animation) or a folder name without extension (OBJ frames)"
+                 (morph-target animation), .exr/.png (vertex-animation texture) or a folder \
+                 name without extension (OBJ frames)"
             ),
         )),
     }
@@ -396,6 +400,10 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
             ),
         ));
     }
+    if kind == OutKind::Vat {
+        let size = (data.frames(), data.vertices());
+        super::vat_out::check(&request.input, &request.out, data.triangles(), size)?;
+    }
     if kind == OutKind::Glb && data.triangles().is_empty() {
         return Err(invalid(
             &request.input,
@@ -442,6 +450,16 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
                 vertices,
             };
             meshio::write_glb_animation_with(&request.out, &clip, &mut decode)?;
+        }
+        OutKind::Vat => {
+            let line = super::vat_out::write(
+                &request.out,
+                data.triangles(),
+                glb_frame_rate(data.frame_rate()),
+                (frames, vertices),
+                |f, p, _| decode(f, p),
+            )?;
+            eprintln!("{line}");
         }
         OutKind::ObjFolder(existing) => super::jumpmap::write_obj_frames(
             &request.out,

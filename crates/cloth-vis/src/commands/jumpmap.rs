@@ -196,6 +196,8 @@ pub const MAX_GENERATED_BYTES: u64 = 4_000_000_000;
 enum OutKind {
     Npy,
     Glb,
+    /// A vertex-animation texture (`.exr`, `.png`).
+    Vat,
     /// With what to do about an existing folder.
     ObjFolder(atomic_out::ExistingFolder),
 }
@@ -224,13 +226,15 @@ pub fn run_jumpmap(
     {
         Some("npy") => OutKind::Npy,
         Some("glb") => OutKind::Glb,
+        Some("exr" | "png") => OutKind::Vat,
         None => OutKind::ObjFolder(super::folder_output(out, request.force)?),
         Some(other) => {
             return Err(invalid(
                 out,
                 format!(
                     "output extension .{other} is not supported: use .npy ([N, V, 3]), .glb \
-                     (morph-target animation) or a folder name without extension (OBJ frames)"
+                     (morph-target animation), .exr/.png (vertex-animation texture) or a \
+                     folder name without extension (OBJ frames)"
                 ),
             ));
         }
@@ -291,6 +295,10 @@ pub fn run_jumpmap(
                 request.memory_limit as f64 / 1e9
             ),
         ));
+    }
+    if matches!(kind, OutKind::Vat) {
+        let size = (request.frames, clip.vertex_count());
+        super::vat_out::check(&request.input, out, &clip.triangles, size)?;
     }
     if strip_gpu.is_some() && clip.triangles.is_empty() {
         return Err(invalid(
@@ -437,6 +445,19 @@ pub fn run_jumpmap(
                 uvs: clip.uvs.clone(),
             };
             meshio::write_glb_animation(out, &animation)?;
+        }
+        OutKind::Vat => {
+            let line = super::vat_out::write(
+                out,
+                &clip.triangles,
+                clip.frame_rate,
+                (frames.len(), vertices),
+                |f, p, _| {
+                    p.copy_from_slice(&frames[f]);
+                    Ok(())
+                },
+            )?;
+            eprintln!("{line}");
         }
         OutKind::ObjFolder(existing) => write_obj_frames(
             out,

@@ -18,6 +18,7 @@ pub mod render;
 pub mod shadows;
 pub mod translucency;
 pub mod up_axis;
+mod vat_out;
 pub mod visibility;
 
 #[cfg(test)]

@@ -34,6 +34,7 @@ use sampler::Clip;
 use source::GltfSource;
 pub use source::{GLTF_DECODE_FLOOR, GLTF_DECODE_PER_INPUT_BYTE};
 pub use stream::{GlbClip, MAX_GLB_ANIMATION_FRAMES, write_glb_animation_with};
+pub(crate) use write::check_topology;
 pub use write::{GlbMesh, NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation};
 
 use crate::validate::{RawMesh, finish_animation, finish_mesh};

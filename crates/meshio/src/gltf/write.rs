@@ -305,7 +305,7 @@ fn check_unit(path: &Path, element: &str, normals: &[Vec3]) -> Result<(), MeshIo
     }
 }
 
-pub(super) fn check_topology(
+pub(crate) fn check_topology(
     path: &Path,
     n: usize,
     triangles: &[[u32; 3]],

@@ -560,6 +560,40 @@ fn glb_output_reads_back_as_the_decoded_frames() {
             );
         }
     }
+    // The same frames as a float vertex-animation texture: exactly the decoder's positions.
+    let vat = dir.path().join("out/decoded.vat.exr");
+    assert_ok(&cli(&[
+        "anim",
+        "decompress",
+        text(&cpca),
+        "--out",
+        text(&vat),
+    ]));
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        &vat,
+        |size, _| {
+            (
+                size.width(),
+                vec![[0.0f32; 4]; size.width() * size.height()],
+            )
+        },
+        |(w, px), pos, (r, g, b, a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = [r, g, b, a]
+        },
+    )
+    .unwrap();
+    let texels = &image.layer_data.channel_data.pixels.1;
+    for (f, frame) in expected.iter().enumerate() {
+        for (v, p) in frame.iter().enumerate() {
+            let t = texels[f * VERTICES + v];
+            assert_eq!(
+                [t[0], t[1], t[2], t[3]],
+                [p.x, p.y, p.z, 1.0],
+                "frame {f} vertex {v}"
+            );
+        }
+    }
+    assert!(dir.path().join("out/decoded.vat.json").is_file());
 }
 
 /// A `.glb` morph animation's weights grow as F²: a clip longer than

@@ -429,3 +429,108 @@ fn shared_gltf_assets_keep_everything_and_validate() {
         );
     }
 }
+
+/// An animation of two quads drifting apart, baked per frame into a float VAT: positions are the
+/// frames, alpha is `visibility --frames`'s a_i of the same frame, exactly.
+#[test]
+fn animation_bakes_per_frame_into_a_vertex_animation_texture() {
+    let dir = tempfile::tempdir().unwrap();
+    let clip = dir.path().join("clip");
+    std::fs::create_dir(&clip).unwrap();
+    let gaps = [0.2f32, 0.5, 2.0];
+    for (f, gap) in gaps.iter().enumerate() {
+        let mut obj = String::new();
+        for y in [0.0, *gap] {
+            for (x, z) in [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0)] {
+                obj.push_str(&format!("v {x} {y} {z}\n"));
+            }
+        }
+        obj.push_str("f 1 2 3\nf 1 3 4\nf 5 6 7\nf 5 7 8\n");
+        std::fs::write(clip.join(format!("frame_{f:03}.obj")), obj).unwrap();
+    }
+    let vat = dir.path().join("clip.vat.exr");
+    let run = cli(&[
+        "bake",
+        text(&clip),
+        "--out",
+        text(&vat),
+        "--level",
+        "2",
+        "--backend",
+        "cpu",
+        "--quiet",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let npy = dir.path().join("a.npy");
+    run_visibility(
+        &VisibilityRequest {
+            level: 2,
+            backend: Some(occlusion_gpu::Backend::Cpu),
+            out: Some(npy.clone()),
+            ..VisibilityRequest::new(clip.clone())
+        },
+        None,
+    )
+    .unwrap();
+    let reference = meshio::read_npy_f32(&npy).unwrap();
+    assert_eq!(reference.shape, [3, 8]);
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        &vat,
+        |size, _| {
+            (
+                size.width(),
+                vec![[0.0f32; 4]; size.width() * size.height()],
+            )
+        },
+        |(w, px), pos, (r, g, b, a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = [r, g, b, a]
+        },
+    )
+    .unwrap();
+    let texels = &image.layer_data.channel_data.pixels.1;
+    let (clip_frames, _) =
+        meshio::load_animation(&clip, &meshio::AnimationOptions::default()).unwrap();
+    for f in 0..3 {
+        for v in 0..8 {
+            let t = texels[f * 8 + v];
+            assert_eq!(
+                [t[0], t[1], t[2]],
+                clip_frames.frames[f][v].to_array(),
+                "frame {f} vertex {v}"
+            );
+            assert_eq!(
+                t[3],
+                reference.data[f * 8 + v],
+                "a_i of frame {f} vertex {v}"
+            );
+        }
+    }
+    // The lower quad opens up as the upper one drifts away.
+    assert!(texels[0][3] < texels[8][3] && texels[8][3] < texels[16][3]);
+    // A point cache without --topology has no triangles: refused, naming the way out.
+    let cache = dir.path().join("clip.npy");
+    meshio::write_npy_f32(
+        &cache,
+        &[3, 8, 3],
+        &clip_frames
+            .frames
+            .concat()
+            .iter()
+            .flat_map(|p| p.to_array())
+            .collect::<Vec<_>>(),
+    )
+    .unwrap();
+    let refused = dir.path().join("refused.vat.png");
+    let run = cli(&["bake", text(&cache), "--out", text(&refused)]);
+    assert!(!run.status.success());
+    assert!(
+        String::from_utf8_lossy(&run.stderr).contains("--topology"),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(!refused.exists());
+}
