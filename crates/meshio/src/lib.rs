@@ -76,6 +76,7 @@ pub use gltf::{
 };
 pub use normals::{compute_normals, compute_normals_into};
 pub use npy::{NpyArray, read_npy_f32, write_npy_f32, write_npy_frames};
+pub use obj::{SeamSplit, load_mesh_split_seams};
 pub use options::{
     AnimationOptions, ClipSelector, DEFAULT_FRAME_RATE, DEFAULT_MAX_FRAMES, LoadOptions,
     MAX_SAMPLED_BYTES, NormalWeighting,

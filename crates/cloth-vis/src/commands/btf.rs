@@ -358,21 +358,38 @@ impl RenderSummary {
 
 /// The mesh of `btf render` as a world object with UVs.
 fn render_mesh(path: &Path) -> Result<cloth_vis::object::WorldObject, Error> {
-    let (positions, triangles, uvs) = if path == Path::new("synth:cloth") {
+    let (positions, triangles, uvs, normals) = if path == Path::new("synth:cloth") {
         let anim = synth::simulate_cloth(&synth::ClothParams::default())?;
         let last = anim.frames.len() - 1;
-        (anim.frames[last].clone(), anim.triangles, Some(anim.uvs))
+        let normals = meshio::compute_normals(
+            &anim.frames[last],
+            &anim.triangles,
+            meshio::NormalWeighting::Angle,
+        );
+        (
+            anim.frames[last].clone(),
+            anim.triangles,
+            Some(anim.uvs),
+            normals,
+        )
     } else {
-        let (mesh, _) = meshio::load_mesh(path, &meshio::LoadOptions::default())?;
-        (mesh.positions, mesh.triangles, mesh.uvs)
+        // UV seams (sewing-pattern garments) split into vertex copies; the normals stay those
+        // of the welded mesh, so the seams do not show in the shading.
+        let options = meshio::LoadOptions {
+            recompute_normals: true,
+            ..meshio::LoadOptions::default()
+        };
+        let (split, _) = meshio::load_mesh_split_seams(path, &options)?;
+        let mesh = split.mesh;
+        (mesh.positions, mesh.triangles, mesh.uvs, mesh.normals)
     };
     if uvs.is_none() {
         return Err(request(
             path,
-            "has no per-vertex texture coordinates, and a BTF is looked up by them".to_owned(),
+            "has no texture coordinates (no vt/TEXCOORD_0), and a BTF is looked up by them"
+                .to_owned(),
         ));
     }
-    let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
     Ok(cloth_vis::object::WorldObject {
         name: path.display().to_string(),
         positions,

@@ -4,6 +4,7 @@
 mod corners;
 pub(crate) mod frames;
 mod parse;
+mod seams;
 
 use std::path::Path;
 
@@ -12,6 +13,7 @@ use glam::{Vec2, Vec3};
 use crate::validate::{RawMesh, finish_mesh};
 use crate::{LoadOptions, LoadReport, Mesh, MeshIoError, SourceFormat};
 pub(crate) use parse::{ObjData, parse_obj};
+pub use seams::{SeamSplit, load_mesh_split_seams};
 
 /// Loads an OBJ file.
 pub(crate) fn load_obj(
