@@ -272,9 +272,17 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         back: None,
         animation: None,
     };
+    let what = format!(
+        "a_i: {} directions x {} vertices ({})",
+        sphere.len(),
+        object.positions.len(),
+        stage.backend().name()
+    );
+    let step = super::spinner(!args.quiet, what);
     let t = Instant::now();
     let (visibility, _) = stage.compute(std::slice::from_ref(&object), &sphere)?;
     let millis = t.elapsed().as_secs_f64() * 1e3;
+    step.finish_and_clear();
     let matrix = visibility.matrix();
     let ambient = matrix.ambient();
     let finite = |v: Vec3| if v.is_finite() { v } else { Vec3::ZERO };

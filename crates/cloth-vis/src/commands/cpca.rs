@@ -322,10 +322,18 @@ pub fn read_cpca(path: &Path) -> Result<(Compressed, usize), Error> {
 pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error> {
     check_cpca_out(&request.out)?;
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
+    let step = super::spinner(true, format!("loading {}", request.input.display()));
     let (clip, _) = meshio::load_animation(
         &request.input,
         &super::animation_options(&request.clip, request.topology.as_deref()),
     )?;
+    step.set_message(format!(
+        "clustered PCA of {} frames x {} vertices (k = {}, c = {})",
+        clip.frames.len(),
+        clip.vertex_count(),
+        request.params.clusters,
+        request.params.components
+    ));
     let start = Instant::now();
     let auto = request.auto_bits;
     let (packed, search, bits) = match request.target {
@@ -359,10 +367,12 @@ pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error>
         }
     };
     let encode_seconds = start.elapsed().as_secs_f64();
+    step.set_message("measuring the distortion of the decoded clip".to_owned());
     let bytes = packed.to_bytes();
     let distortion = Decoder::new(&packed)
         .distortion(&clip.frames)
         .map_err(|e| anim_error(&request.input, e))?;
+    step.finish_and_clear();
     atomic_out::write_with(&request.out, |w| w.write_all(&bytes))?;
     Ok(CompressSummary {
         vertices: packed.vertices(),
@@ -418,10 +428,18 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
     let decoder = Decoder::new(&data);
     let mut scratch = decoder.scratch();
     let mut decoding = std::time::Duration::ZERO;
+    // A .glb asks for every frame but the first twice (bounds, then bytes).
+    let calls = if kind == OutKind::Glb {
+        2 * data.frames() - 1
+    } else {
+        data.frames()
+    };
+    let bar = cloth_vis::run::progress_bar(true, calls as u64, "decoding frames");
     let mut decode = |f: usize, out: &mut [Vec3]| -> Result<(), Error> {
         let t = Instant::now();
         let result = decoder.frame_into(f, out, &mut scratch);
         decoding += t.elapsed();
+        bar.inc(1);
         result.map_err(|e| anim_error(&request.input, e))
     };
     let (frames, vertices) = (decoder.frames(), decoder.vertices());
@@ -472,6 +490,7 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
             "cloth-vis anim decompress",
         )?,
     }
+    bar.finish_and_clear();
     let decode_seconds = decoding.as_secs_f64();
     Ok(DecompressSummary {
         vertices: data.vertices(),

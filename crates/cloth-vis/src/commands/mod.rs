@@ -101,3 +101,20 @@ pub fn print_line(line: &str) -> anyhow::Result<()> {
     writeln!(std::io::stdout().lock(), "{line}")?;
     Ok(())
 }
+
+/// A spinner on stderr for one long step whose length is unknown (a clustered PCA fit, one
+/// frame of GPU depth passes): `message` and the elapsed time, ticking on its own thread.
+/// indicatif draws nothing when stderr is not a terminal, so pipelines and tests stay clean;
+/// `show = false` (`--quiet`) hides it everywhere.
+pub fn spinner(show: bool, message: String) -> indicatif::ProgressBar {
+    if !show {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new_spinner();
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+        bar.set_style(style);
+    }
+    bar.set_message(message);
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    bar
+}

@@ -434,6 +434,11 @@ pub fn run_visibility(
     let mut last = None;
     let mut millis = 0.0;
     let bar = progress_bar(request.progress && count > 1, count as u64, "frames");
+    let what = format!(
+        "visibility: {k} directions x {n} vertices ({})",
+        stage.backend().name()
+    );
+    let step = super::spinner(request.progress && count == 1, what);
     for frame in start..end {
         objects[0].pose(frame);
         let t = Instant::now();
@@ -447,6 +452,7 @@ pub fn run_visibility(
         bar.inc(1);
     }
     bar.finish_and_clear();
+    step.finish_and_clear();
     let visibility = last.ok_or_else(|| invalid(input, "no frame to compute".to_owned()))?;
     let last_ambient = &ambient[(count - 1) * n..];
     // c_i = (1/π) Σ_j M_ij I_j ω_j of a white surface (NaN for unused vertices), or the grey
