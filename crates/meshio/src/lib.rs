@@ -23,13 +23,19 @@
 //! | `.ply` (ASCII, binary LE/BE; faces or `tristrips`) | ✓ | one frame |
 //! | `.obj` | ✓ | one frame |
 //! | folder of numbered `.obj` frames | | ✓ (numeric order, parallel parse) |
-//! | `.gltf` / `.glb` | rest pose of the scene | skinning + morph targets sampled at a frame rate |
+//! | `.gltf` / `.glb` (also `KHR_mesh_quantization`, `EXT_meshopt_compression`: gltfpack) | rest pose of the scene | skinning + morph targets sampled at a frame rate |
 //! | `.npy` `[F, V, 3]` f32/f64 | | ✓ (triangles from [`AnimationOptions::topology`]) |
 //! | `.pc2`, `.mdd` point caches | | ✓ (triangles from [`AnimationOptions::topology`]) |
 //!
+//! An OBJ whose UVs differ between the corners of a vertex (UV seams) loads with the UVs dropped
+//! by [`load_mesh`] (vertex i stays vertex i) or kept by [`load_mesh_split_seams`] (seam
+//! vertices split, a map back to the file's vertices).
+//!
 //! Output: [`write_npy_f32`]; [`write_pc2`], [`write_mdd`]; [`write_glb`] (a [`GlbMesh`] with normals, linear float
 //! `COLOR_0` and custom scalar attributes such as `_AO`); [`write_glb_animation`] (frames as
-//! morph targets driven by a `STEP` weights clip, read back by [`load_animation`]). All writers
+//! morph targets driven by a `STEP` weights clip, read back by [`load_animation`]);
+//! [`write_gltf_with`] (the user's own glTF with baked attributes added, everything else kept);
+//! [`write_vat_with`] (vertex-animation textures for engine shaders). All writers
 //! validate first and write atomically (through [`atomic_out`], whose errors arrive as
 //! [`MeshIoError::Io`]).
 //!

@@ -453,7 +453,7 @@ fn compressed_geometry_extensions_are_named() {
     let dir = tempfile::tempdir().unwrap();
     for (extension, hint) in [
         ("KHR_draco_mesh_compression", "without Draco"),
-        ("EXT_meshopt_compression", "gltfpack without -c"),
+        ("KHR_meshopt_compression", "EXT_meshopt_compression"),
     ] {
         let doc = json!({
             "asset": {"version": "2.0"},
@@ -473,6 +473,77 @@ fn compressed_geometry_extensions_are_named() {
             assert!(message.contains(needle), "{needle:?} missing: {message}");
         }
         assert!(!message.contains("Missing data"), "{message}");
+    }
+}
+
+/// EXT_meshopt_compression is decoded (tests/meshopt.rs, on gltfpack's output); a compressed
+/// view whose source lies outside its buffer, or whose decoded size exceeds the view, is an
+/// error naming the view, and a fallback buffer declaring more than the file may decode to is
+/// refused before it is allocated.
+#[test]
+fn hostile_meshopt_views_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = |view_ext: serde_json::Value, fallback_len: u64| {
+        json!({
+            "asset": {"version": "2.0"},
+            "extensionsUsed": ["EXT_meshopt_compression"],
+            "extensionsRequired": ["EXT_meshopt_compression"],
+            "scenes": [{"nodes": [0]}],
+            "nodes": [{"mesh": 0}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+            "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                           "min": [0, 0, 0], "max": [1, 1, 0]}],
+            "bufferViews": [{"buffer": 1, "byteLength": 36, "byteStride": 12,
+                             "extensions": {"EXT_meshopt_compression": view_ext}}],
+            "buffers": [
+                {"byteLength": 8, "uri": "data:application/octet-stream;base64,AAAAAAAAAAA="},
+                {"byteLength": fallback_len, "extensions": {"EXT_meshopt_compression": {"fallback": true}}}
+            ],
+        })
+    };
+    let cases = [
+        (
+            base(
+                json!({"buffer": 0, "byteOffset": 4, "byteLength": 100, "byteStride": 12, "count": 3, "mode": "ATTRIBUTES"}),
+                36,
+            ),
+            "bytes 4+100 of buffer 0",
+        ),
+        (
+            base(
+                json!({"buffer": 0, "byteLength": 8, "byteStride": 12, "count": 30, "mode": "ATTRIBUTES"}),
+                36,
+            ),
+            "exceed the view's byteLength",
+        ),
+        (
+            base(
+                json!({"buffer": 0, "byteLength": 8, "byteStride": 12, "count": 3, "mode": "ATTRIBUTES"}),
+                36,
+            ),
+            "vertex codec",
+        ),
+        (
+            base(
+                json!({"buffer": 0, "byteLength": 8, "byteStride": 12, "count": 3, "mode": "SPIRAL"}),
+                36,
+            ),
+            "mode \"SPIRAL\"",
+        ),
+        (
+            base(
+                json!({"buffer": 0, "byteLength": 8, "byteStride": 12, "count": 3, "mode": "ATTRIBUTES"}),
+                1 << 40,
+            ),
+            "fallback buffers declare",
+        ),
+    ];
+    for (doc, needle) in cases {
+        let path = common::write(dir.path(), "packed.gltf", serde_json::to_vec(&doc).unwrap());
+        let message = load_mesh(&path, &LoadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains(needle), "{needle:?} missing: {message}");
     }
 }
 

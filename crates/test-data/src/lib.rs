@@ -151,3 +151,41 @@ pub fn validate_gltf(path: &std::path::Path) -> Option<GltfValidation> {
         summary,
     })
 }
+
+/// Runs gltfpack (meshoptimizer's glTF packer, the npm package `gltfpack`, installed beside the
+/// validator by `.ci/run`) with `args`; `Some(())` when it succeeded.
+///
+/// # Panics
+/// When gltfpack is missing and [`in_ci`] is true (through [`skip`]), or when it runs and
+/// fails: the test cannot do what it means to.
+#[track_caller]
+pub fn gltfpack(args: &[&std::ffi::OsStr]) -> Option<()> {
+    let modules = std::env::var(GLTF_VALIDATOR_ENV).map_or_else(
+        |_| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../target/gltf-validator/node_modules")
+        },
+        PathBuf::from,
+    );
+    let cli = modules.join("gltfpack/cli.js");
+    if !cli.is_file() {
+        return skip(&format!(
+            "gltfpack is not installed in {} (npm install --prefix target/gltf-validator gltfpack)",
+            modules.display()
+        ));
+    }
+    let output = match std::process::Command::new("node")
+        .arg(&cli)
+        .args(args)
+        .output()
+    {
+        Ok(output) => output,
+        Err(e) => return skip(&format!("node cannot run ({e}); install Node.js")),
+    };
+    assert!(
+        output.status.success(),
+        "gltfpack {args:?} failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    Some(())
+}

@@ -139,7 +139,8 @@ pub fn write_gltf_with(
     check_values(&src, &rig, bake)?;
     let raw = input_guard::read_regular(input).map_err(|e| MeshIoError::io(input, "read", e))?;
     let json_bytes = if src.is_glb {
-        glb_json_chunk(&raw).ok_or_else(|| gltf_error(input, "file", "GLB JSON chunk is cut"))?
+        source::glb_json_chunk(&raw)
+            .ok_or_else(|| gltf_error(input, "file", "GLB JSON chunk is cut"))?
     } else {
         &raw[..]
     };
@@ -157,12 +158,6 @@ pub fn write_gltf_with(
 }
 
 use std::io::Write as _;
-
-/// The bytes of a GLB's JSON chunk (header and chunk lengths checked by the loader already).
-fn glb_json_chunk(raw: &[u8]) -> Option<&[u8]> {
-    let len = u32::from_le_bytes(raw.get(12..16)?.try_into().ok()?) as usize;
-    raw.get(20..20usize.checked_add(len)?)
-}
 
 /// The output's BIN chunk and what was done.
 #[derive(Default)]
@@ -244,10 +239,26 @@ fn check_values(src: &GltfSource, rig: &Rig, bake: &GltfBake<'_>) -> Result<(), 
 }
 
 /// Copies every buffer into the output's BIN and re-points the buffer views at buffer 0.
+/// `EXT_meshopt_compression` views were decoded into their fallback buffer on loading: they are
+/// written decoded (the extension dropped; gltfpack compresses the result again if wanted).
 fn merge_buffers(src: &GltfSource, root: &mut Value, out: &mut Output) {
     let offsets: Vec<usize> = src.buffers.iter().map(|b| out.append(b)).collect();
-    if let Some(views) = root["bufferViews"].as_array_mut() {
+    for list in ["extensionsUsed", "extensionsRequired"] {
+        if let Some(names) = root.get_mut(list).and_then(Value::as_array_mut) {
+            names.retain(|n| n != "EXT_meshopt_compression");
+            if names.is_empty() {
+                root.as_object_mut().map(|o| o.remove(list));
+            }
+        }
+    }
+    if let Some(views) = root.get_mut("bufferViews").and_then(Value::as_array_mut) {
         for view in views {
+            if let Some(extensions) = view.get_mut("extensions").and_then(Value::as_object_mut) {
+                extensions.remove("EXT_meshopt_compression");
+                if extensions.is_empty() {
+                    view.as_object_mut().map(|o| o.remove("extensions"));
+                }
+            }
             let buffer = view["buffer"].as_u64().unwrap_or(0) as usize;
             let old = view["byteOffset"].as_u64().unwrap_or(0) as usize;
             view["buffer"] = json!(0);

@@ -14,6 +14,7 @@
 
 mod accessor;
 mod augment;
+mod meshopt;
 mod pose;
 mod rig;
 mod sampler;

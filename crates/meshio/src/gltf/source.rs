@@ -91,11 +91,37 @@ pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| gltf_error(path, "file", format!("cannot parse: {e}; is it glTF 2.0?")))?;
     validate(path, gltf.document.as_json())?;
+    // The raw JSON, for what the `gltf` crate does not model (EXT_meshopt_compression).
+    let json_bytes = if is_glb {
+        glb_json_chunk(&bytes).unwrap_or_default()
+    } else {
+        &bytes[..]
+    };
+    let raw: serde_json::Value = serde_json::from_slice(json_bytes).unwrap_or_default();
+    let fallbacks = super::meshopt::fallback_buffers(&raw);
+    let fallback_bytes: u64 = fallbacks.iter().map(|(_, len)| *len as u64).sum();
+    let fallback_budget = GLTF_DECODE_FLOOR
+        .saturating_add((bytes.len() as u64).saturating_mul(GLTF_DECODE_PER_INPUT_BYTE));
+    if fallback_bytes > fallback_budget {
+        return Err(gltf_error(
+            path,
+            "buffers",
+            format!(
+                "EXT_meshopt_compression fallback buffers declare {fallback_bytes} bytes, more \
+                 than this file may decode to ({fallback_budget})"
+            ),
+        ));
+    }
     let mut blob = gltf.blob;
     let base = path.parent().unwrap_or(Path::new("."));
     let mut buffers = Vec::new();
     for buffer in gltf.document.buffers() {
         let element = format!("buffer {}", buffer.index());
+        if let Some((_, len)) = fallbacks.iter().find(|(i, _)| *i == buffer.index()) {
+            // Filled by the decoder below; a fallback buffer carries no data of its own.
+            buffers.push(vec![0; *len]);
+            continue;
+        }
         let data = match buffer.source() {
             gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
                 gltf_error(
@@ -119,6 +145,7 @@ pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
         }
         buffers.push(data);
     }
+    super::meshopt::decode_views(path, &raw, &mut buffers)?;
     let input_bytes = bytes.len() as u64 + buffers.iter().map(|b| b.len() as u64).sum::<u64>();
     let budget_total =
         GLTF_DECODE_FLOOR.saturating_add(input_bytes.saturating_mul(GLTF_DECODE_PER_INPUT_BYTE));
@@ -133,7 +160,7 @@ pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
 }
 
 /// Required extensions this reader decodes beyond what the `gltf` crate validates.
-pub const SUPPORTED_REQUIRED: [&str; 1] = ["KHR_mesh_quantization"];
+pub const SUPPORTED_REQUIRED: [&str; 2] = ["KHR_mesh_quantization", "EXT_meshopt_compression"];
 
 /// Runs the `gltf` crate's validation, after the checks that keep it from panicking.
 fn validate(path: &Path, root: &gltf::json::Root) -> Result<(), MeshIoError> {
@@ -160,9 +187,10 @@ fn validate(path: &Path, root: &gltf::json::Root) -> Result<(), MeshIoError> {
                 "Draco-compressed geometry, which is not decoded here: export the file \
                  without Draco compression (Blender's glTF exporter: Compression off)"
             }
-            "EXT_meshopt_compression" | "KHR_meshopt_compression" => {
-                "meshoptimizer-compressed buffers (gltfpack -c/-cc), which are not decoded \
-                 here yet: run gltfpack without -c/-cc"
+            "KHR_meshopt_compression" => {
+                "meshoptimizer-compressed buffers in the KHR form (its v1 codecs and colour \
+                 filter), which are not decoded here yet: write EXT_meshopt_compression \
+                 (gltfpack -c without -cx) or no compression"
             }
             _ => continue,
         };
@@ -244,6 +272,12 @@ pub(super) fn read_uri(
     let file = input_guard::confined_join(base, &relative)
         .map_err(|e| gltf_error(path, element, e.to_string()))?;
     input_guard::read_regular(&file).map_err(|e| MeshIoError::io(&file, "read", e))
+}
+
+/// The bytes of a GLB's JSON chunk; `None` when the header or chunk is cut.
+pub(super) fn glb_json_chunk(raw: &[u8]) -> Option<&[u8]> {
+    let len = u32::from_le_bytes(raw.get(12..16)?.try_into().ok()?) as usize;
+    raw.get(20..20usize.checked_add(len)?)
 }
 
 /// Decodes `%XX` escapes; `None` for a malformed escape or non-UTF-8 result.

@@ -534,3 +534,61 @@ fn animation_bakes_per_frame_into_a_vertex_animation_texture() {
     );
     assert!(!refused.exists());
 }
+
+/// A gltfpack -cc file (quantized, EXT_meshopt_compression with the octahedral and quaternion
+/// filters) bakes too: written decoded (the extension dropped), valid, COLOR_0 on every vertex
+/// equal to `visibility` on the same (decoded) mesh.
+#[test]
+fn a_meshopt_compressed_asset_bakes_decoded_and_valid() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(input) = test_data::shared_file("anim/gltf/BrainStem.glb") else {
+        return;
+    };
+    let packed = dir.path().join("brainstem-cc.glb");
+    let args = [
+        std::ffi::OsStr::new("-i"),
+        input.as_os_str(),
+        std::ffi::OsStr::new("-o"),
+        packed.as_os_str(),
+        std::ffi::OsStr::new("-cc"),
+    ];
+    if test_data::gltfpack(&args).is_none() {
+        return;
+    }
+    let out = dir.path().join("baked.glb");
+    let run = cli(&[
+        "bake",
+        text(&packed),
+        "--out",
+        text(&out),
+        "--level",
+        "2",
+        "--backend",
+        "cpu",
+        "--quiet",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let (root, bin) = read_glb(&out);
+    assert!(
+        !serde_json::to_string(&root)
+            .unwrap()
+            .contains("EXT_meshopt_compression")
+    );
+    let colours: Vec<f32> = scene_meshes(&root)
+        .into_iter()
+        .flat_map(|m| attribute_values(&root, &bin, m, "COLOR_0"))
+        .collect();
+    let reference = reference_ambient(&packed, dir.path());
+    assert_eq!(colours.len(), 3 * reference.len());
+    for (v, a) in reference.iter().enumerate() {
+        let a = if a.is_finite() { *a } else { 1.0 };
+        assert_eq!(colours[3 * v], a, "vertex {v}");
+    }
+    if let Some(report) = test_data::validate_gltf(&out) {
+        assert!(report.ok, "{}", report.summary);
+    }
+}
