@@ -172,6 +172,16 @@ pub fn load_animation(
             };
             Ok((animation, report))
         }
+        // No maintained Rust crate reads Alembic meshes (ogawa-rs 0.4 parses the container and
+        // curves only; the `alembic` crate is a placeholder): say what to export instead.
+        "abc" => Err(MeshIoError::UnsupportedFormat {
+            path: path.to_path_buf(),
+            extension: "abc".to_string(),
+            expected: "Alembic is not read here (no maintained Rust reader of its PolyMesh \
+                       schema); export the cache as .pc2 or .mdd (Blender, Maya, Houdini and 3ds \
+                       Max all write them) with the rest mesh as --topology, or as an animated \
+                       .glb or a folder of numbered .obj frames",
+        }),
         other => Err(MeshIoError::UnsupportedFormat {
             path: path.to_path_buf(),
             extension: other.to_string(),

@@ -440,6 +440,14 @@ fn unsupported_extension() {
     assert!(
         matches!(load(&path), Err(MeshIoError::UnsupportedFormat { extension, .. }) if extension == "stl")
     );
+    // Alembic is named, with the formats to export instead.
+    let path = write(dir.path(), "cloth.abc", "Ogawa");
+    let message = meshio::load_animation(&path, &meshio::AnimationOptions::default())
+        .unwrap_err()
+        .to_string();
+    for needle in ["cloth.abc", "Alembic", ".pc2", "--topology"] {
+        assert!(message.contains(needle), "{needle:?} missing: {message}");
+    }
 }
 
 // ---------------------------------------------------------------- degenerate, duplicate, unreferenced
