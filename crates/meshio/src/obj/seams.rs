@@ -43,32 +43,27 @@ pub fn load_mesh_split_seams(
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
     let (mesh, report) = crate::load_mesh(path, options)?;
-    let seams = is_obj && mesh.uvs.is_none() && !options.remove_unreferenced;
-    if !seams {
+    let unsplit = |mesh: Mesh, report| {
         let n = mesh.positions.len();
-        return Ok((
+        let source = (0..n as u32).collect();
+        Ok((
             SeamSplit {
                 mesh,
-                source: (0..n as u32).collect(),
+                source,
                 source_count: n,
             },
             report,
-        ));
+        ))
+    };
+    if !(is_obj && mesh.uvs.is_none() && !options.remove_unreferenced) {
+        return unsplit(mesh, report);
     }
     let data = input_guard::read_regular(path).map_err(|e| MeshIoError::io(path, "read", e))?;
     let mut split_report = LoadReport::new(path, SourceFormat::Obj);
     let obj = parse_obj(path, &data, &mut split_report)?;
     let Some(corner_tex) = &obj.corner_tex else {
         // No `vt` at all: nothing to split.
-        let n = mesh.positions.len();
-        return Ok((
-            SeamSplit {
-                mesh,
-                source: (0..n as u32).collect(),
-                source_count: n,
-            },
-            report,
-        ));
+        return unsplit(mesh, report);
     };
     let n = obj.positions.len();
     let uv_of = |i: u32| {

@@ -569,20 +569,7 @@ fn glb_output_reads_back_as_the_decoded_frames() {
         "--out",
         text(&vat),
     ]));
-    let image = exr::prelude::read_first_rgba_layer_from_file(
-        &vat,
-        |size, _| {
-            (
-                size.width(),
-                vec![[0.0f32; 4]; size.width() * size.height()],
-            )
-        },
-        |(w, px), pos, (r, g, b, a): (f32, f32, f32, f32)| {
-            px[pos.y() * *w + pos.x()] = [r, g, b, a]
-        },
-    )
-    .unwrap();
-    let texels = &image.layer_data.channel_data.pixels.1;
+    let (_, _, texels) = super::common::read_exr_rgba(&vat);
     for (f, frame) in expected.iter().enumerate() {
         for (v, p) in frame.iter().enumerate() {
             let t = texels[f * VERTICES + v];

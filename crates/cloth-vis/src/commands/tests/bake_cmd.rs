@@ -9,6 +9,17 @@ use serde_json::{Value, json};
 use super::common::{cli, text};
 use crate::commands::visibility::{VisibilityRequest, run_visibility};
 
+/// Runs `cloth-vis ARGS` and asserts it succeeded; returns its output.
+fn bake_ok(args: &[&str]) -> std::process::Output {
+    let run = cli(args);
+    assert!(
+        run.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    run
+}
+
 /// A GLB's JSON and BIN chunk.
 fn read_glb(path: &Path) -> (Value, Vec<u8>) {
     let bytes = std::fs::read(path).unwrap();
@@ -138,7 +149,7 @@ fn two_instances_bake_apart_embedded_and_equal_to_visibility() {
     let dir = tempfile::tempdir().unwrap();
     let input = two_quads(dir.path(), 0.3, "tex.png");
     let out = dir.path().join("baked.glb");
-    let run = cli(&[
+    let run = bake_ok(&[
         "bake",
         text(&input),
         "--out",
@@ -148,11 +159,6 @@ fn two_instances_bake_apart_embedded_and_equal_to_visibility() {
         "--backend",
         "cpu",
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(stdout.contains("1 mesh(es) duplicated"), "{stdout}");
     let (root, bin) = read_glb(&out);
@@ -197,7 +203,7 @@ fn two_instances_bake_apart_embedded_and_equal_to_visibility() {
 
     // --max-distance below the gap: both quads see an open sky, identical values.
     let bounded = dir.path().join("bounded.glb");
-    let run = cli(&[
+    bake_ok(&[
         "bake",
         text(&input),
         "--out",
@@ -207,11 +213,6 @@ fn two_instances_bake_apart_embedded_and_equal_to_visibility() {
         "--max-distance",
         "0.25",
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     let (root, bin) = read_glb(&bounded);
     assert_eq!(
         attribute_values(&root, &bin, 0, "COLOR_0"),
@@ -272,7 +273,7 @@ fn obj_keeps_every_line_and_colours_each_vertex() {
     obj.push_str("f 1/1 3/3 2/2\r\nf 1/1 4/4 3/3\r\ng wall\r\nf 5/2 6/3 7/4\r\nf 5/2 7/4 8/1\r\n");
     std::fs::write(&input, &obj).unwrap();
     let out = dir.path().join("baked.obj");
-    let run = cli(&[
+    bake_ok(&[
         "bake",
         text(&input),
         "--out",
@@ -282,11 +283,6 @@ fn obj_keeps_every_line_and_colours_each_vertex() {
         "--backend",
         "cpu",
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     let reference = reference_ambient(&input, dir.path());
     let baked = std::fs::read_to_string(&out).unwrap();
     let (mut v, mut lines) = (0, 0);
@@ -333,7 +329,7 @@ fn shared_gltf_assets_keep_everything_and_validate() {
             return;
         };
         let out = dir.path().join(format!("{name}.glb"));
-        let run = cli(&[
+        bake_ok(&[
             "bake",
             text(&input),
             "--out",
@@ -345,11 +341,6 @@ fn shared_gltf_assets_keep_everything_and_validate() {
             "--sky",
             "--bent-normals",
         ]);
-        assert!(
-            run.status.success(),
-            "{name}: {}",
-            String::from_utf8_lossy(&run.stderr)
-        );
         let (before, bin_before) = read_glb(&input);
         let (after, bin_after) = read_glb(&out);
         for key in [
@@ -449,7 +440,7 @@ fn animation_bakes_per_frame_into_a_vertex_animation_texture() {
         std::fs::write(clip.join(format!("frame_{f:03}.obj")), obj).unwrap();
     }
     let vat = dir.path().join("clip.vat.exr");
-    let run = cli(&[
+    bake_ok(&[
         "bake",
         text(&clip),
         "--out",
@@ -460,11 +451,6 @@ fn animation_bakes_per_frame_into_a_vertex_animation_texture() {
         "cpu",
         "--quiet",
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     let npy = dir.path().join("a.npy");
     run_visibility(
         &VisibilityRequest {
@@ -478,20 +464,7 @@ fn animation_bakes_per_frame_into_a_vertex_animation_texture() {
     .unwrap();
     let reference = meshio::read_npy_f32(&npy).unwrap();
     assert_eq!(reference.shape, [3, 8]);
-    let image = exr::prelude::read_first_rgba_layer_from_file(
-        &vat,
-        |size, _| {
-            (
-                size.width(),
-                vec![[0.0f32; 4]; size.width() * size.height()],
-            )
-        },
-        |(w, px), pos, (r, g, b, a): (f32, f32, f32, f32)| {
-            px[pos.y() * *w + pos.x()] = [r, g, b, a]
-        },
-    )
-    .unwrap();
-    let texels = &image.layer_data.channel_data.pixels.1;
+    let (_, _, texels) = super::common::read_exr_rgba(&vat);
     let (clip_frames, _) =
         meshio::load_animation(&clip, &meshio::AnimationOptions::default()).unwrap();
     for f in 0..3 {
@@ -556,7 +529,7 @@ fn a_meshopt_compressed_asset_bakes_decoded_and_valid() {
         return;
     }
     let out = dir.path().join("baked.glb");
-    let run = cli(&[
+    bake_ok(&[
         "bake",
         text(&packed),
         "--out",
@@ -567,11 +540,6 @@ fn a_meshopt_compressed_asset_bakes_decoded_and_valid() {
         "cpu",
         "--quiet",
     ]);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
     let (root, bin) = read_glb(&out);
     assert!(
         !serde_json::to_string(&root)

@@ -41,3 +41,26 @@ pub fn cli_env(args: &[&str], envs: &[(&str, &str)]) -> std::process::Output {
 pub fn text(p: &Path) -> &str {
     p.to_str().unwrap()
 }
+
+/// An RGBA float EXR: width, height and the pixels row-major from the top.
+pub fn read_exr_rgba(path: &Path) -> (usize, usize, Vec<[f32; 4]>) {
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |size, _| {
+            (
+                size.width(),
+                vec![[0.0f32; 4]; size.width() * size.height()],
+            )
+        },
+        |(w, px), pos, (r, g, b, a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = [r, g, b, a]
+        },
+    )
+    .unwrap();
+    let size = image.layer_data.size;
+    (
+        size.width(),
+        size.height(),
+        image.layer_data.channel_data.pixels.1,
+    )
+}
