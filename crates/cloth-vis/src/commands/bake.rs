@@ -26,6 +26,9 @@
 //!   every frame, a_i **of that frame** in alpha — per-frame baking of a deforming mesh, one
 //!   engine for all frames (the cpu backend refits its BVH), a progress bar over frames.
 //!
+//! `--per-face FILE.npy` adds a_f per triangle: the ambient term at the triangle's centroid about
+//! its face normal (receivers without triangles of their own, in the same engine call).
+//!
 //! Vertices used by no face get a_i = 1 in colours (NaN in the PLY's `ao`) and zero radiance.
 
 use std::io::Write as _;
@@ -94,6 +97,11 @@ pub struct BakeArgs {
     /// Also write `_BENT_NORMAL` (glTF): the cosine-weighted mean open direction.
     #[arg(long)]
     bent_normals: bool,
+    /// Also write a_f per triangle (at its centroid, about its face normal) as f32 [T] .npy,
+    /// triangles in the loaded mesh's order (polygons fan-triangulated in place; NaN for a
+    /// degenerate triangle).
+    #[arg(long, value_name = "FILE.npy")]
+    per_face: Option<PathBuf>,
     /// HDR environment (.hdr/.exr): also write `_RADIANCE` (glTF), unclamped.
     #[arg(long, conflicts_with = "sky")]
     env: Option<PathBuf>,
@@ -215,6 +223,16 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
             ),
         ));
     }
+    if let Some(path) = &args.per_face {
+        super::refuse_overwriting_input(path, &[input])?;
+        if vat || lower_extension(path).as_deref() != Some("npy") {
+            return Err(invalid(
+                path,
+                "--per-face writes a_f of a mesh's triangles as .npy (not with a VAT output)"
+                    .to_owned(),
+            ));
+        }
+    }
     let mut scene = Scene::one_object(input, "cloth-vis bake")?;
     scene.lighting.level = args.level;
     scene.visibility.backend = match args.backend.as_deref() {
@@ -260,31 +278,35 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         &mesh.triangles,
         meshio::NormalWeighting::Angle,
     );
-    let object = WorldObject {
-        name: scene.name.clone(),
-        positions: mesh.positions.clone(),
+    let n = mesh.positions.len();
+    let mut objects = vec![world_object(
+        mesh.positions.clone(),
         normals,
-        triangles: mesh.triangles.clone(),
-        uvs: mesh.uvs.clone(),
-        albedo: Vec3::ONE,
-        two_sided: false,
-        front: None,
-        back: None,
-        animation: None,
-    };
+        mesh.triangles.clone(),
+    )];
+    if args.per_face.is_some() {
+        // Triangle centroids as receivers without triangles of their own: rows after the
+        // vertices', the same engine and rays.
+        let (centroids, face_normals) = face_receivers(&mesh.positions, &mesh.triangles);
+        objects.push(world_object(centroids, face_normals, Vec::new()));
+    }
     let what = format!(
         "a_i: {} directions x {} vertices ({})",
         sphere.len(),
-        object.positions.len(),
+        n,
         stage.backend().name()
     );
     let step = super::spinner(!args.quiet, what);
     let t = Instant::now();
-    let (visibility, _) = stage.compute(std::slice::from_ref(&object), &sphere)?;
+    let (visibility, _) = stage.compute(&objects, &sphere)?;
     let millis = t.elapsed().as_secs_f64() * 1e3;
     step.finish_and_clear();
     let matrix = visibility.matrix();
-    let ambient = matrix.ambient();
+    let mut ambient = matrix.ambient();
+    let per_face = ambient.split_off(n);
+    if let Some(path) = &args.per_face {
+        meshio::write_npy_f32(path, &[per_face.len()], &per_face)?;
+    }
     let finite = |v: Vec3| if v.is_finite() { v } else { Vec3::ZERO };
     let radiance: Option<Vec<Vec3>> = match &environment {
         Some(env) => {
@@ -292,13 +314,18 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
             Some(
                 shadowed_radiance(matrix, &sphere, &light)?
                     .into_iter()
+                    .take(n)
                     .map(finite)
                     .collect(),
             )
         }
         None => None,
     };
-    let bent = args.bent_normals.then(|| matrix.bent_normals());
+    let bent = args.bent_normals.then(|| {
+        let mut bent = matrix.bent_normals();
+        bent.truncate(n);
+        bent
+    });
     let mut gltf = None;
     match kind {
         Kind::Gltf => {
@@ -379,18 +406,7 @@ fn bake_vat(
     for frame in &animation.frames[start..end] {
         let normals =
             meshio::compute_normals(frame, &animation.triangles, meshio::NormalWeighting::Angle);
-        let object = WorldObject {
-            name: "bake".to_owned(),
-            positions: frame.clone(),
-            normals,
-            triangles: animation.triangles.clone(),
-            uvs: None,
-            albedo: Vec3::ONE,
-            two_sided: false,
-            front: None,
-            back: None,
-            animation: None,
-        };
+        let object = world_object(frame.clone(), normals, animation.triangles.clone());
         let t = Instant::now();
         let (visibility, _) = stage.compute(std::slice::from_ref(&object), sphere)?;
         millis += t.elapsed().as_secs_f64() * 1e3;
@@ -421,6 +437,37 @@ fn bake_vat(
         millis,
         gltf: None,
     })
+}
+
+/// A white one-sided object of the bake's scene.
+fn world_object(positions: Vec<Vec3>, normals: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> WorldObject {
+    WorldObject {
+        name: "bake".to_owned(),
+        positions,
+        normals,
+        triangles,
+        uvs: None,
+        albedo: Vec3::ONE,
+        two_sided: false,
+        front: None,
+        back: None,
+        animation: None,
+    }
+}
+
+/// Each triangle's centroid (in f64) and unit face normal (zero for a degenerate triangle,
+/// whose a_f is then NaN).
+fn face_receivers(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<Vec3>, Vec<Vec3>) {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize].as_dvec3());
+            (
+                ((a + b + c) / 3.0).as_vec3(),
+                (b - a).cross(c - a).normalize_or_zero().as_vec3(),
+            )
+        })
+        .unzip()
 }
 
 /// a_i as a colour value: clamped to [0, 1], 1 where undefined (a vertex used by no face).

@@ -81,7 +81,24 @@ pub(crate) fn load_gltf_mesh(
     path: &Path,
     options: &LoadOptions,
 ) -> Result<(Mesh, LoadReport), MeshIoError> {
-    let (_, rig, report) = open_rig(path)?;
+    let (src, rig, mut report) = open_rig(path)?;
+    // The rule for an animated glTF, the same everywhere: what holds one shape per vertex (this
+    // loader, `cloth-vis bake` into the asset, `btf render`) takes the rest pose; what runs over
+    // frames (load_animation: `visibility`, `anim`, bake to a VAT) samples a clip, the first
+    // unless one is chosen.
+    let clips: Vec<String> = src
+        .document
+        .animations()
+        .map(|a| format!("{} {:?}", a.index(), a.name().unwrap_or("")))
+        .collect();
+    if !clips.is_empty() {
+        report.notes.push(format!(
+            "the rest pose of a file with {} animation clip(s) ({}); frame-by-frame consumers \
+             sample clip 0 unless another is chosen (cloth-vis: --clip, or --animation here)",
+            clips.len(),
+            clips.join(", ")
+        ));
+    }
     let pose = rig.rest_pose();
     let positions = rig.positions(&pose);
     let normals = if options.recompute_normals {

@@ -560,3 +560,71 @@ fn a_meshopt_compressed_asset_bakes_decoded_and_valid() {
         assert!(report.ok, "{}", report.summary);
     }
 }
+
+/// `--per-face`: a_f at each triangle's centroid about its face normal — equal to the engine's
+/// ambient term of that point computed on its own, darker under the other quad.
+#[test]
+fn per_face_values_are_the_ambient_term_at_the_centroids() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = two_quads(dir.path(), 0.3, "tex.png");
+    let out = dir.path().join("baked.glb");
+    let faces = dir.path().join("faces.npy");
+    bake_ok(&[
+        "bake",
+        text(&input),
+        "--out",
+        text(&out),
+        "--level",
+        "2",
+        "--backend",
+        "cpu",
+        "--per-face",
+        text(&faces),
+        "--quiet",
+    ]);
+    let a_f = meshio::read_npy_f32(&faces).unwrap();
+    assert_eq!(a_f.shape, [4]);
+    let (mesh, _) = meshio::load_mesh(&input, &meshio::LoadOptions::default()).unwrap();
+    let sphere = lightsphere::Lightsphere::new(2).unwrap();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let [a, b, c] = tri.map(|i| mesh.positions[i as usize].as_dvec3());
+        let centroid = ((a + b + c) / 3.0).as_vec3();
+        let mut scene = occlusion_gpu::Scene::new();
+        scene
+            .push(
+                occlusion_gpu::SceneObject::new(
+                    mesh.positions.clone(),
+                    mesh.normals.clone(),
+                    mesh.triangles.clone(),
+                )
+                .occluder_only(),
+            )
+            .unwrap();
+        scene
+            .push(occlusion_gpu::SceneObject::new(
+                vec![centroid],
+                vec![glam::Vec3::Y],
+                Vec::new(),
+            ))
+            .unwrap();
+        let mut engine =
+            occlusion_gpu::VisibilityEngine::cpu(occlusion_gpu::VisibilityParams::default());
+        let alone = engine.compute(&scene, &sphere).unwrap().ambient()[0];
+        assert_eq!(a_f.data[t], alone, "triangle {t}");
+    }
+    assert!(
+        a_f.data[0] < a_f.data[2] && a_f.data[1] < a_f.data[3],
+        "{:?}",
+        a_f.data
+    );
+    // Not with a VAT output, and only as .npy.
+    let run = cli(&[
+        "bake",
+        text(&input),
+        "--out",
+        text(&out),
+        "--per-face",
+        text(&dir.path().join("f.txt")),
+    ]);
+    assert!(!run.status.success());
+}
