@@ -7,6 +7,7 @@ pub mod bake;
 pub mod btf;
 pub mod cpca;
 mod cpca_bits;
+mod cpca_decompress;
 mod cpca_figures;
 mod cpca_search;
 pub mod hemicube;

@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use crate::commands::cpca::{
-    AutoBits, CompressRequest, DEFAULT_K_MAX, DecompressRequest, SearchMode, run_compress,
-    run_decompress, run_stats,
+    AutoBits, CompressRequest, DEFAULT_K_MAX, SearchMode, run_compress, run_stats,
 };
+use crate::commands::cpca_decompress::{DecompressRequest, run_decompress};
 use anim_pca::compress::{Compressed, Decoder, bpvf_from_file};
 use glam::Vec3;
 
