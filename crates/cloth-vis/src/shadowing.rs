@@ -99,6 +99,12 @@ impl VisibilityStage {
         self.backend
     }
 
+    /// Reports progress inside each later [`VisibilityStage::compute`]: (cells done, cells),
+    /// a cell being one (vertex row, direction) ([`occlusion_gpu::ProgressFn`]); `None` stops.
+    pub fn set_progress(&mut self, progress: Option<occlusion_gpu::ProgressFn>) {
+        self.engine.set_progress(progress);
+    }
+
     /// M for all objects as posed, each object occluding all others; two-sided objects get a
     /// second set of rows with flipped normals. Returns M and what the run report records.
     ///

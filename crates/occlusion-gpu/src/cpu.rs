@@ -46,12 +46,12 @@ use obvhs::BvhBuildParams;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::ray::Ray;
-use obvhs::triangle::Triangle;
 use rayon::prelude::*;
 
 use crate::fan::{FanTracer, RayFan, fan_groups};
 use crate::matrix::WORD_BITS;
-use crate::refit::LeafOrder;
+use crate::progress::Ticker;
+use crate::refit::{LeafOrder, padded_bvh2, scene_triangles};
 use crate::scene::Prepared;
 
 /// Ray origin offset along the normal, relative to the scene's bounding-box diagonal: the
@@ -297,16 +297,16 @@ impl CpuTracer {
     }
 }
 
-/// Fills the bits of columns `columns` of every row (`bits` is row-major with
-/// `words_per_row` words); the other columns are left as they are. Returns the rays cast.
+/// Fills the bits of columns `columns` of every row (`target.bits` is row-major with
+/// `target.words_per_row` words); the other columns are left as they are; each finished chunk
+/// of rows is counted on `target.ticker`. Returns the rays cast.
 pub(crate) fn compute_columns(
     prepared: &Prepared,
     tracer: &Tracer,
     directions: &[Vec3],
     columns: Range<usize>,
     params: &CpuParams,
-    bits: &mut [u32],
-    words_per_row: usize,
+    target: ColumnsTarget<'_>,
 ) -> u64 {
     if columns.is_empty() {
         return 0;
@@ -317,16 +317,20 @@ pub(crate) fn compute_columns(
     };
     let dirs: Vec<Vec3A> = directions.iter().map(|&d| d.into()).collect();
     match &tracer.kind {
-        TracerKind::Packets(t) => {
-            packet_columns(prepared, t, &dirs, columns, span, bits, words_per_row)
-        }
-        TracerKind::Fans(t) => {
-            fan_columns(prepared, t, directions, columns, span, bits, words_per_row)
-        }
-        TracerKind::SingleRays(t) => {
-            bvh_columns(prepared, t, &dirs, columns, span, bits, words_per_row)
-        }
+        TracerKind::Packets(t) => packet_columns(prepared, t, &dirs, columns, span, target),
+        TracerKind::Fans(t) => fan_columns(prepared, t, directions, columns, span, target),
+        TracerKind::SingleRays(t) => bvh_columns(prepared, t, &dirs, columns, span, target),
     }
+}
+
+/// Where [`compute_columns`] writes: the row-major bits of M, and the progress counter.
+pub(crate) struct ColumnsTarget<'a> {
+    /// M's bits, `words_per_row` words per row.
+    pub(crate) bits: &'a mut [u32],
+    /// Words per row of `bits`.
+    pub(crate) words_per_row: usize,
+    /// Counts the cells of finished chunks of rows.
+    pub(crate) ticker: &'a Ticker,
 }
 
 /// Where every ray of a call starts and ends: origins pushed `offset` along the normal, hits
@@ -548,9 +552,13 @@ fn packet_columns(
     dirs: &[Vec3A],
     columns: Range<usize>,
     span: RaySpan,
-    bits: &mut [u32],
-    words_per_row: usize,
+    target: ColumnsTarget<'_>,
 ) -> u64 {
+    let ColumnsTarget {
+        bits,
+        words_per_row,
+        ticker,
+    } = target;
     let order = morton_order(prepared);
     let chunks: Vec<(Vec<u32>, u64)> = order
         .par_chunks(PACKET)
@@ -581,6 +589,7 @@ fn packet_columns(
                     out[r * words_per_row + j / WORD_BITS] |= 1 << (j % WORD_BITS);
                 }
             }
+            ticker.tick((rows.len() * columns.len()) as u64);
             (out, rays)
         })
         .collect();
@@ -605,9 +614,13 @@ fn bvh_columns(
     dirs: &[Vec3A],
     columns: Range<usize>,
     span: RaySpan,
-    bits: &mut [u32],
-    words_per_row: usize,
+    target: ColumnsTarget<'_>,
 ) -> u64 {
+    let ColumnsTarget {
+        bits,
+        words_per_row,
+        ticker,
+    } = target;
     let order = morton_order(prepared);
     let chunks: Vec<(Vec<u32>, u64)> = order
         .par_chunks(ROWS_PER_CHUNK)
@@ -634,6 +647,7 @@ fn bvh_columns(
                     }
                 }
             }
+            ticker.tick((rows.len() * columns.len()) as u64);
             (out, rays)
         })
         .collect();
@@ -649,9 +663,13 @@ fn fan_columns(
     directions: &[Vec3],
     columns: Range<usize>,
     span: RaySpan,
-    bits: &mut [u32],
-    words_per_row: usize,
+    target: ColumnsTarget<'_>,
 ) -> u64 {
+    let ColumnsTarget {
+        bits,
+        words_per_row,
+        ticker,
+    } = target;
     let dirs = &directions[columns.clone()];
     let groups = fan_groups(dirs);
     let fans: Vec<RayFan> = groups.iter().map(|g| RayFan::from_group(dirs, g)).collect();
@@ -676,6 +694,7 @@ fn fan_columns(
                     }
                 }
             }
+            ticker.tick((rows.len() * columns.len()) as u64);
             (out, rays)
         })
         .collect();
@@ -705,60 +724,6 @@ fn scatter_chunks(
         }
     }
     rays
-}
-
-/// A binary BVH (`obvhs`'s PLOC build with `quality`'s settings, at most `leaf_size` triangles
-/// per leaf) over the scene's triangles, with every box padded a little so that the slab test
-/// never drops a ray that the triangle test (with its [`EDGE_TOLERANCE`]) counts as a hit on
-/// the box's boundary; the triangles come back in leaf order. Empty for a scene without
-/// triangles.
-pub(crate) fn padded_bvh2(
-    prepared: &Prepared,
-    quality: BvhBuildParams,
-    leaf_size: u32,
-) -> (Vec<obvhs::bvh2::node::Bvh2Node>, Vec<Triangle>, LeafOrder) {
-    let tris = scene_triangles(prepared);
-    if tris.is_empty() {
-        return (Vec::new(), Vec::new(), LeafOrder::new(&[], Vec::new()));
-    }
-    let mut params = quality;
-    params.max_prims_per_leaf = leaf_size;
-    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
-    let ordered = bvh
-        .primitive_indices
-        .iter()
-        .map(|&i| tris[i as usize])
-        .collect();
-    let mut nodes = bvh.nodes;
-    for node in &mut nodes {
-        crate::refit::pad(&mut node.aabb, prepared.diagonal);
-    }
-    let leaves = LeafOrder::new(&nodes, bvh.primitive_indices);
-    (nodes, ordered, leaves)
-}
-
-/// The triangles of `prepared` in `leaves`' order (what a refitted tree's leaves index).
-pub(crate) fn leaf_triangles(prepared: &Prepared, leaves: &LeafOrder) -> Vec<[Vec3A; 3]> {
-    leaves
-        .order
-        .iter()
-        .map(|&t| {
-            prepared.triangles[t as usize].map(|v| Vec3A::from(prepared.positions[v as usize]))
-        })
-        .collect()
-}
-
-/// The scene's triangles as `obvhs` takes them (degenerate ones included: they never hit).
-fn scene_triangles(prepared: &Prepared) -> Vec<Triangle> {
-    prepared
-        .triangles
-        .iter()
-        .map(|t| Triangle {
-            v0: prepared.positions[t[0] as usize].into(),
-            v1: prepared.positions[t[1] as usize].into(),
-            v2: prepared.positions[t[2] as usize].into(),
-        })
-        .collect()
 }
 
 /// The receiver rows sorted by the Morton code of their positions (10 bits per axis over the

@@ -3,10 +3,11 @@
 
 use lightsphere::Lightsphere;
 
-use crate::cpu::{CpuParams, Tracer, compute_columns};
+use crate::cpu::{ColumnsTarget, CpuParams, Tracer, compute_columns};
 use crate::depth_params::DepthParams;
 #[cfg(feature = "gpu")]
 use crate::gpu::{DepthPipelines, DepthRun, GpuVisibility, QueryPipelines};
+use crate::progress::{ProgressFn, Ticker};
 use crate::scene::Prepared;
 use crate::{OcclusionError, Scene, VisibilityMatrix};
 
@@ -150,6 +151,7 @@ pub struct VisibilityEngine {
     params: VisibilityParams,
     last_rays: u64,
     last_bvh: BvhStats,
+    progress: Option<ProgressFn>,
 }
 
 impl VisibilityEngine {
@@ -163,6 +165,7 @@ impl VisibilityEngine {
             params,
             last_rays: 0,
             last_bvh: NO_BVH,
+            progress: None,
         }
     }
 
@@ -198,6 +201,7 @@ impl VisibilityEngine {
             params,
             last_rays: 0,
             last_bvh: NO_BVH,
+            progress: None,
         }
     }
 
@@ -215,6 +219,41 @@ impl VisibilityEngine {
     /// The parameters in use.
     pub fn params(&self) -> &VisibilityParams {
         &self.params
+    }
+
+    /// Reports progress inside every later computation ([`ProgressFn`]: cells done of the
+    /// call's rows × new columns), or stops reporting (`None`). The result does not depend on
+    /// it.
+    ///
+    /// # Examples
+    /// ```
+    /// # use std::sync::{Arc, atomic::{AtomicU64, Ordering}};
+    /// # use occlusion_gpu::{Scene, SceneObject, VisibilityEngine, VisibilityParams};
+    /// # use glam::Vec3;
+    /// let mut scene = Scene::new();
+    /// scene.push(SceneObject::new(
+    ///     vec![Vec3::ZERO, Vec3::X, Vec3::Z],
+    ///     vec![Vec3::Y; 3],
+    ///     vec![[0, 1, 2]],
+    /// ))?;
+    /// let sphere = lightsphere::Lightsphere::new(2)?;
+    /// let seen = Arc::new(AtomicU64::new(0));
+    /// let mut engine = VisibilityEngine::cpu(VisibilityParams::default());
+    /// let last = Arc::clone(&seen);
+    /// engine.set_progress(Some(Arc::new(move |done, _total| {
+    ///     last.fetch_max(done, Ordering::Relaxed);
+    /// })));
+    /// engine.compute(&scene, &sphere)?;
+    /// assert_eq!(seen.load(Ordering::Relaxed), 3 * sphere.len() as u64);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn set_progress(&mut self, progress: Option<ProgressFn>) {
+        self.progress = progress;
+    }
+
+    /// A counter over `rows` × the columns `first..k` reporting to the caller's function.
+    fn ticker(&self, rows: usize, columns: usize) -> Ticker {
+        Ticker::new((rows * columns) as u64, self.progress.clone())
     }
 
     /// How the last `cpu` computation obtained its BVH (reused, refitted, built) and the time
@@ -398,6 +437,10 @@ impl VisibilityEngine {
         first: usize,
     ) -> Result<(&Gpu, DepthRun), OcclusionError> {
         let params = self.params.depth;
+        let ticker = std::sync::Arc::new(self.ticker(
+            prepared.receivers.len(),
+            directions.len().saturating_sub(first),
+        ));
         match &mut self.state {
             State::Cpu { .. } => Err(OcclusionError::NoDevice {
                 backend: Backend::Cpu.name(),
@@ -412,6 +455,7 @@ impl VisibilityEngine {
                     solid_angles,
                     first,
                     &params,
+                    &ticker,
                 )?;
                 Ok((gpu, run))
             }
@@ -431,6 +475,7 @@ impl VisibilityEngine {
                     solid_angles,
                     first,
                     &params,
+                    &ticker,
                 )?;
                 Ok((gpu, run))
             }
@@ -459,6 +504,7 @@ impl VisibilityEngine {
         if first_new >= k {
             return Ok(());
         }
+        let ticker = self.ticker(matrix.rows(), k - first_new);
         match &mut self.state {
             State::Cpu {
                 tracer: cached,
@@ -500,8 +546,11 @@ impl VisibilityEngine {
                     &directions,
                     first_new..k,
                     &self.params.cpu,
-                    matrix.bits_mut(),
-                    words_per_row,
+                    ColumnsTarget {
+                        bits: matrix.bits_mut(),
+                        words_per_row,
+                        ticker: &ticker,
+                    },
                 );
                 let per_cell = start.elapsed().as_secs_f64() * 1e3 / cells.max(1.0);
                 match update {

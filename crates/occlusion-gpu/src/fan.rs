@@ -39,8 +39,9 @@ use glam::{BVec3A, BVec4A, Mat3, Vec3, Vec3A, Vec4};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::node::Bvh2Node;
 
-use crate::cpu::{EDGE_TOLERANCE, padded_bvh2};
+use crate::cpu::EDGE_TOLERANCE;
 use crate::refit::LeafOrder;
+use crate::refit::padded_bvh2;
 use crate::scene::Prepared;
 
 /// Rays per fan: one bit each of a `u64` mask.

@@ -102,6 +102,7 @@ mod filter;
 mod gpu;
 mod level;
 mod matrix;
+mod progress;
 mod rays;
 mod refit;
 mod rigid;
@@ -129,6 +130,7 @@ pub use level::{
     DEFAULT_RISE_FRACTION, LevelChange, LevelController, LevelParams,
 };
 pub use matrix::{VisibilityMatrix, clamp_ambient};
+pub use progress::ProgressFn;
 pub use rays::{RayCache, RayCaster};
 pub use refit::REBUILD_SAH_RATIO;
 pub use rigid::RigidLighting;

@@ -10,9 +10,15 @@
 //! 2.2 ms build tolerates ~6 % of degradation; a fixed 1.5 cap alone made refitting 7.5 %
 //! slower than rebuilding every frame there.
 
+use std::time::Duration;
+
 use glam::{Vec3, Vec3A};
+use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::node::Bvh2Node;
+use obvhs::triangle::Triangle;
+
+use crate::scene::Prepared;
 
 /// Never keep a refitted tree whose SAH cost exceeds its build-time cost by this factor.
 pub const REBUILD_SAH_RATIO: f32 = 1.5;
@@ -107,7 +113,7 @@ pub(crate) fn refit(
     Some(sah_cost(nodes))
 }
 
-/// Refits a tree built by [`crate::cpu::padded_bvh2`] and its leaf-ordered triangle data to
+/// Refits a tree built by [`padded_bvh2`] and its leaf-ordered triangle data to
 /// `prepared`'s positions (same topology): the boxes through [`refit`], each triangle remade
 /// by `make`. The new SAH cost over the build's.
 pub(crate) fn refit_tree<T>(
@@ -124,11 +130,62 @@ pub(crate) fn refit_tree<T>(
         &prepared.triangles,
         prepared.diagonal,
     )?;
-    for (slot, t) in triangles
-        .iter_mut()
-        .zip(crate::cpu::leaf_triangles(prepared, leaves))
-    {
+    for (slot, t) in triangles.iter_mut().zip(leaf_triangles(prepared, leaves)) {
         *slot = make(t);
     }
     Some(cost / leaves.build_cost.max(f32::MIN_POSITIVE))
+}
+
+/// A binary BVH (`obvhs`'s PLOC build with `quality`'s settings, at most `leaf_size` triangles
+/// per leaf) over the scene's triangles, with every box padded a little so that the slab test
+/// never drops a ray that the triangle test (with its [`crate::cpu::EDGE_TOLERANCE`]) counts as a hit on
+/// the box's boundary; the triangles come back in leaf order. Empty for a scene without
+/// triangles.
+pub(crate) fn padded_bvh2(
+    prepared: &Prepared,
+    quality: BvhBuildParams,
+    leaf_size: u32,
+) -> (Vec<obvhs::bvh2::node::Bvh2Node>, Vec<Triangle>, LeafOrder) {
+    let tris = scene_triangles(prepared);
+    if tris.is_empty() {
+        return (Vec::new(), Vec::new(), LeafOrder::new(&[], Vec::new()));
+    }
+    let mut params = quality;
+    params.max_prims_per_leaf = leaf_size;
+    let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
+    let ordered = bvh
+        .primitive_indices
+        .iter()
+        .map(|&i| tris[i as usize])
+        .collect();
+    let mut nodes = bvh.nodes;
+    for node in &mut nodes {
+        pad(&mut node.aabb, prepared.diagonal);
+    }
+    let leaves = LeafOrder::new(&nodes, bvh.primitive_indices);
+    (nodes, ordered, leaves)
+}
+
+/// The triangles of `prepared` in `leaves`' order (what a refitted tree's leaves index).
+pub(crate) fn leaf_triangles(prepared: &Prepared, leaves: &LeafOrder) -> Vec<[Vec3A; 3]> {
+    leaves
+        .order
+        .iter()
+        .map(|&t| {
+            prepared.triangles[t as usize].map(|v| Vec3A::from(prepared.positions[v as usize]))
+        })
+        .collect()
+}
+
+/// The scene's triangles as `obvhs` takes them (degenerate ones included: they never hit).
+pub(crate) fn scene_triangles(prepared: &Prepared) -> Vec<Triangle> {
+    prepared
+        .triangles
+        .iter()
+        .map(|t| Triangle {
+            v0: prepared.positions[t[0] as usize].into(),
+            v1: prepared.positions[t[1] as usize].into(),
+            v2: prepared.positions[t[2] as usize].into(),
+        })
+        .collect()
 }

@@ -296,7 +296,7 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         n,
         stage.backend().name()
     );
-    let step = super::spinner(!args.quiet, what);
+    let step = super::engine_bar(!args.quiet, &mut stage, what);
     let t = Instant::now();
     let (visibility, _) = stage.compute(&objects, &sphere)?;
     let millis = t.elapsed().as_secs_f64() * 1e3;

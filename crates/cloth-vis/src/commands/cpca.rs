@@ -53,6 +53,8 @@ pub struct CompressRequest {
     pub auto_bits: AutoBits,
     /// The `.cpca` file to write.
     pub out: PathBuf,
+    /// Show the spinner over loading, fitting and measuring (stderr, terminals only).
+    pub progress: bool,
 }
 
 /// Largest k `--target-da`/`--target-bpvf` tries unless told (`--k-max`).
@@ -248,7 +250,10 @@ pub fn read_cpca(path: &Path) -> Result<(Compressed, usize), Error> {
 pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error> {
     check_cpca_out(&request.out)?;
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
-    let step = super::spinner(true, format!("loading {}", request.input.display()));
+    let step = super::spinner(
+        request.progress,
+        format!("loading {}", request.input.display()),
+    );
     let (clip, _) = meshio::load_animation(
         &request.input,
         &super::animation_options(&request.clip, request.topology.as_deref()),
@@ -501,6 +506,9 @@ pub struct CompressArgs {
     /// Output: FILE.cpca.
     #[arg(long)]
     out: PathBuf,
+    /// Hide the progress spinner.
+    #[arg(long)]
+    quiet: bool,
 }
 
 impl CompressArgs {
@@ -559,6 +567,7 @@ impl CompressArgs {
                 weights: self.qw.is_none(),
             },
             out: self.out,
+            progress: !self.quiet,
         };
         super::print_line(&run_compress(&request)?.line())
     }

@@ -21,6 +21,8 @@ pub struct DecompressRequest {
     pub out: PathBuf,
     /// Replace an output folder that holds files (else refused before any work).
     pub force: bool,
+    /// Show the bar over decoded frames (stderr, terminals only).
+    pub progress: bool,
 }
 
 /// What `decompress` wrote.
@@ -132,7 +134,7 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
     } else {
         data.frames()
     };
-    let bar = cloth_vis::run::progress_bar(true, calls as u64, "decoding frames");
+    let bar = cloth_vis::run::progress_bar(request.progress, calls as u64, "decoding frames");
     let mut decode = |f: usize, out: &mut [Vec3]| -> Result<(), Error> {
         let t = Instant::now();
         let result = decoder.frame_into(f, out, &mut scratch);
@@ -222,6 +224,9 @@ pub struct DecompressArgs {
     /// Replace an existing output folder that holds files, once the new frames are complete.
     #[arg(long)]
     force: bool,
+    /// Hide the progress bar.
+    #[arg(long)]
+    quiet: bool,
 }
 
 impl DecompressArgs {
@@ -231,6 +236,7 @@ impl DecompressArgs {
             input: self.input,
             out: self.out,
             force: self.force,
+            progress: !self.quiet,
         };
         super::print_line(&run_decompress(&request)?.line())
     }

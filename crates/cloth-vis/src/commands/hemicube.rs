@@ -90,6 +90,8 @@ pub struct HemicubeRequest {
     pub exposure_ev: Option<f32>,
     /// Rendered image size.
     pub render_size: [u32; 2],
+    /// Show the bar over the map build (stderr, terminals only).
+    pub progress: bool,
 }
 
 /// What was computed.
@@ -248,7 +250,11 @@ fn build_maps(
     let mut params = BuildParams::default();
     params.max_distance = request.max_distance;
     // A bar on stderr (hidden when it is not a terminal) for builds over a second.
-    let bar = cloth_vis::run::progress_bar(true, caster.receiver_count() as u64, "visibility maps");
+    let bar = cloth_vis::run::progress_bar(
+        request.progress,
+        caster.receiver_count() as u64,
+        "visibility maps",
+    );
     let progress = |n: u64| bar.inc(n);
     let maps = match (builder, gpu) {
         (Builder::Gpu, Some(gpu)) => {
@@ -526,6 +532,9 @@ pub struct HemicubeArgs {
     /// Rendered image size.
     #[arg(long, value_name = "WxH", value_parser = super::parse::size, default_value = DEFAULT_RENDER_SIZE)]
     render_size: [u32; 2],
+    /// Hide the progress bar.
+    #[arg(long)]
+    quiet: bool,
 }
 
 impl HemicubeArgs {
@@ -596,6 +605,7 @@ impl HemicubeArgs {
             render: self.render,
             exposure_ev: self.exposure,
             render_size: self.render_size,
+            progress: !self.quiet,
         })
     }
 

@@ -104,7 +104,7 @@ pub fn print_line(line: &str) -> anyhow::Result<()> {
 }
 
 /// A spinner on stderr for one long step whose length is unknown (a clustered PCA fit, one
-/// frame of GPU depth passes): `message` and the elapsed time, ticking on its own thread.
+/// loading an animation): `message` and the elapsed time, ticking on its own thread.
 /// indicatif draws nothing when stderr is not a terminal, so pipelines and tests stay clean;
 /// `show = false` (`--quiet`) hides it everywhere.
 pub fn spinner(show: bool, message: String) -> indicatif::ProgressBar {
@@ -117,5 +117,34 @@ pub fn spinner(show: bool, message: String) -> indicatif::ProgressBar {
     }
     bar.set_message(message);
     bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    bar
+}
+
+/// A bar over the (vertex, direction) cells of each computation `stage` runs next, fed by the
+/// engine from inside the call (chunks of rows on the cpu backend, batches of directions as the
+/// GPU finishes them); hidden (and the stage left silent) when `show` is false. Finish it with
+/// `finish_and_clear` after the call.
+pub fn engine_bar(
+    show: bool,
+    stage: &mut cloth_vis::shadowing::VisibilityStage,
+    message: String,
+) -> indicatif::ProgressBar {
+    if !show {
+        stage.set_progress(None);
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(0);
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% ({elapsed}, {eta})")
+    {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(message);
+    let feed = bar.clone();
+    stage.set_progress(Some(std::sync::Arc::new(move |done, total| {
+        feed.set_length(total);
+        // Worker threads may report slightly out of order: never step back.
+        feed.set_position(done.max(feed.position()));
+    })));
     bar
 }

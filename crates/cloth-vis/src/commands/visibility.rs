@@ -438,7 +438,7 @@ pub fn run_visibility(
         "visibility: {k} directions x {n} vertices ({})",
         stage.backend().name()
     );
-    let step = super::spinner(request.progress && count == 1, what);
+    let step = super::engine_bar(request.progress && count == 1, &mut stage, what);
     for frame in start..end {
         objects[0].pose(frame);
         let t = Instant::now();

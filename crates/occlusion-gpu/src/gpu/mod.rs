@@ -31,6 +31,7 @@ pub use resident::GpuVisibility;
 pub(crate) use crate::depth_params::DepthParams;
 
 use crate::matrix::WORD_BITS;
+use crate::progress::Ticker;
 use crate::scene::Prepared;
 use crate::{OcclusionError, VisibilityMatrix};
 
@@ -196,6 +197,7 @@ impl DepthPipelines {
         solid_angles: &[f64],
         first: usize,
         params: &DepthParams,
+        ticker: &std::sync::Arc<Ticker>,
     ) -> Result<DepthRun, OcclusionError> {
         let limits = device.limits();
         let resolution = check_resolution(device, params.resolution)?;
@@ -327,6 +329,13 @@ impl DepthPipelines {
                 pass.dispatch_workgroups(groups_x, groups_y, 1);
             }
             queue.submit([encoder.finish()]);
+            // Counted when the device has finished the batch (fired by this poll or a later
+            // one, at the latest the read-back's wait).
+            let done = std::sync::Arc::clone(ticker);
+            let cells = (rows * layer_count) as u64;
+            queue.on_submitted_work_done(move || done.tick(cells));
+            // A failed non-blocking poll leaves the callbacks to the read-back's wait.
+            let _ = device.poll(wgpu::PollType::Poll);
             first_direction += layer_count;
         }
         Ok(scene.into_run(prepared))

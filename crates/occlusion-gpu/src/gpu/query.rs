@@ -27,6 +27,7 @@ use super::{
     check_resolution, storage_entry,
 };
 use crate::OcclusionError;
+use crate::progress::Ticker;
 use crate::scene::Prepared;
 
 /// Queries per batch of directions (64 query sets, 2 MiB of resolved counts). A batch is one
@@ -192,6 +193,7 @@ impl QueryPipelines {
         solid_angles: &[f64],
         first: usize,
         params: &DepthParams,
+        ticker: &std::sync::Arc<Ticker>,
     ) -> Result<DepthRun, OcclusionError> {
         let resolution = check_resolution(device, params.resolution)?;
         let scene = SceneBuffers::new(device, prepared, directions, solid_angles)?;
@@ -338,6 +340,13 @@ impl QueryPipelines {
                 pass.dispatch_workgroups(groups_x, groups_y, 1);
             }
             queue.submit([encoder.finish()]);
+            // Counted when the device has finished the batch (fired by this poll or a later
+            // one, at the latest the read-back's wait).
+            let done = std::sync::Arc::clone(ticker);
+            let cells = (rows * direction_count) as u64;
+            queue.on_submitted_work_done(move || done.tick(cells));
+            // A failed non-blocking poll leaves the callbacks to the read-back's wait.
+            let _ = device.poll(wgpu::PollType::Poll);
             first_direction += direction_count;
         }
         Ok(scene.into_run(prepared))

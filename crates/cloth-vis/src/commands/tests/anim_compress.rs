@@ -172,6 +172,7 @@ fn time_compression_and_obj_folder_output() {
         ..Default::default()
     };
     let summary = run_compress(&CompressRequest {
+        progress: false,
         input: input.clone(),
         clip: meshio::ClipSelector::First,
         topology: None,
@@ -197,6 +198,7 @@ fn time_compression_and_obj_folder_output() {
     std::fs::create_dir(&folder).unwrap();
     std::fs::write(folder.join("frame_99999.obj"), "stale").unwrap();
     let refused = run_decompress(&DecompressRequest {
+        progress: false,
         input: cpca.clone(),
         out: folder.clone(),
         force: false,
@@ -206,6 +208,7 @@ fn time_compression_and_obj_folder_output() {
     assert!(refused.contains("--force"), "{refused}");
     assert_eq!(std::fs::read_dir(&folder).unwrap().count(), 1);
     run_decompress(&DecompressRequest {
+        progress: false,
         input: cpca.clone(),
         out: folder.clone(),
         force: true,
@@ -242,6 +245,7 @@ fn time_compression_and_obj_folder_output() {
     // Same parameters and seed: the same file.
     let again = dir.path().join("again.cpca");
     run_compress(&CompressRequest {
+        progress: false,
         input,
         clip: meshio::ClipSelector::First,
         topology: None,
@@ -330,6 +334,7 @@ fn unsupported_outputs_are_refused_before_any_work() {
         ..Default::default()
     };
     run_compress(&CompressRequest {
+        progress: false,
         input,
         clip: meshio::ClipSelector::First,
         topology: None,
@@ -344,6 +349,7 @@ fn unsupported_outputs_are_refused_before_any_work() {
     .unwrap();
     let glb = dir.path().join("clip.glb");
     let err = run_decompress(&DecompressRequest {
+        progress: false,
         input: cpca.clone(),
         out: glb.clone(),
         force: false,
@@ -617,6 +623,7 @@ fn a_clip_too_long_for_glb_is_refused_before_decoding() {
 /// `anim compress INPUT --clusters K --components C --out CPCA`, through the library.
 fn compress_into(input: &Path, cpca: &Path, clusters: usize, components: usize) {
     run_compress(&CompressRequest {
+        progress: false,
         input: input.to_owned(),
         clip: meshio::ClipSelector::First,
         topology: None,
@@ -650,6 +657,7 @@ fn default_bits_are_the_fewest_within_one_percent_of_the_unquantized_error() {
     };
     let run = |auto_bits, params, name: &str| {
         run_compress(&CompressRequest {
+            progress: false,
             input: input.clone(),
             clip: meshio::ClipSelector::First,
             topology: None,

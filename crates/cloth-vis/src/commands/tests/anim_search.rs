@@ -73,6 +73,7 @@ fn a_target_searches_every_parameter_by_default_and_keeps_the_budget() {
     let dir = tempfile::tempdir().unwrap();
     let (input, frames) = write_clip(dir.path());
     let request = |search: SearchMode, out: &Path| CompressRequest {
+        progress: false,
         input: input.clone(),
         clip: meshio::ClipSelector::First,
         topology: None,
