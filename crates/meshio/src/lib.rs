@@ -77,8 +77,8 @@ pub use error::MeshIoError;
 pub use gltf::{
     BakeValues, ColourChannel, DoubleSided, GLTF_DECODE_FLOOR, GLTF_DECODE_PER_INPUT_BYTE, GlbClip,
     GlbMesh, GltfBake, GltfBakeReport, MAX_GLB_ANIMATION_FRAMES, MAX_VIEWLESS_ELEMENTS,
-    NORMAL_UNIT_TOLERANCE, write_glb, write_glb_animation, write_glb_animation_with,
-    write_gltf_with,
+    NORMAL_UNIT_TOLERANCE, text_gltf_buffer, write_glb, write_glb_animation,
+    write_glb_animation_with, write_gltf_with,
 };
 pub use normals::{compute_normals, compute_normals_into};
 pub use npy::{NpyArray, read_npy_f32, write_npy_f32, write_npy_frames};

@@ -8,8 +8,9 @@
 //! animated glTF at frame 0 of its first clip instead).
 //!
 //! Outputs by the input's kind:
-//! - `.glb`/`.gltf` → `.glb` ([`meshio::write_gltf_with`]): every node, mesh, material, texture,
-//!   skin, animation and extension kept, buffers and images embedded byte for byte; a_i as
+//! - `.glb`/`.gltf` → `.glb`, or `.gltf` + `.bin` of the same name ([`meshio::write_gltf_with`]):
+//!   every node, mesh, material, texture, skin, animation and extension kept, buffers and images
+//!   embedded byte for byte; a_i as
 //!   **linear** vertex colour in the chosen channel (`COLOR_0` RGB by default, `COLOR_0.a` over
 //!   the existing colour, or `COLOR_1`), `_RADIANCE` (`VEC3` float, unclamped, a white
 //!   Lambertian surface: c_i = (1/π) Σ_j M_ij I_j ω_j) under `--env`/`--sky`, `_BENT_NORMAL`
@@ -74,8 +75,9 @@ pub struct BakeArgs {
     /// The asset: .glb, .gltf, .obj or .ply; for a .exr/.png output an animation (folder of
     /// numbered .obj, animated .glb, point cache .npy/.pc2/.mdd with --topology).
     input: PathBuf,
-    /// Output: .glb for a glTF input, .obj for an OBJ, .ply for a PLY; .exr/.png for a
-    /// vertex-animation texture of an animation with a_i per frame in alpha.
+    /// Output: .glb (or .gltf + .bin beside it) for a glTF input, .obj for an OBJ, .ply for a
+    /// PLY; .exr/.png for a vertex-animation texture of an animation with a_i per frame in
+    /// alpha.
     #[arg(long)]
     out: PathBuf,
     /// Lightsphere level s (k = 2 + 4^(s+1) directions), as for `visibility`.
@@ -209,19 +211,25 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
     } else {
         kind_of(input, "the input")?
     };
-    let wanted = match kind {
-        Kind::Gltf => "glb",
-        Kind::Obj => "obj",
-        Kind::Ply => "ply",
-        Kind::Vat => "exr",
+    let wanted: &[&str] = match kind {
+        Kind::Gltf => &["glb", "gltf"],
+        Kind::Obj => &["obj"],
+        Kind::Ply => &["ply"],
+        Kind::Vat => &["exr"],
     };
-    if !vat && lower_extension(&args.out).as_deref() != Some(wanted) {
+    let out_extension = lower_extension(&args.out);
+    if !vat && !wanted.contains(&out_extension.as_deref().unwrap_or("")) {
         return Err(invalid(
             &args.out,
             format!(
-                "--out must be a .{wanted} for this input (the input's kind, its content kept)"
+                "--out must be a .{} for this input (the input's kind, its content kept)",
+                wanted.join(" or .")
             ),
         ));
+    }
+    if out_extension.as_deref() == Some("gltf") {
+        // Its buffer file beside it must not be the input either.
+        super::refuse_overwriting_input(&meshio::text_gltf_buffer(&args.out), &[input])?;
     }
     if let Some(path) = &args.per_face {
         super::refuse_overwriting_input(path, &[input])?;

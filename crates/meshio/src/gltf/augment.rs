@@ -10,7 +10,8 @@
 //!   at it; their bytes are unchanged;
 //! - images given by URI (a file beside the input, or a `data:` URI) are embedded as buffer
 //!   views with their `mimeType` (from the extension or the data URI), so the output is one
-//!   self-contained `.glb` wherever it is written;
+//!   self-contained `.glb` wherever it is written — or, for a `.gltf` output, the JSON file and
+//!   one `.bin` of the same name beside it ([`text_gltf_buffer`]);
 //! - a mesh instantiated by several nodes is duplicated for the second and later nodes (sharing
 //!   every existing accessor), because each instance bakes to different values and a glTF
 //!   primitive has one set of attributes.
@@ -120,7 +121,8 @@ pub struct GltfBakeReport {
     pub colours_replaced: usize,
 }
 
-/// Writes `output` (`.glb`): the glTF `input` with the values of `bake` added to every primitive
+/// Writes `output` — a `.glb`, or a `.gltf` with its one buffer in [`text_gltf_buffer`] beside
+/// it — the glTF `input` with the values of `bake` added to every primitive
 /// its scene instantiates. Values are in the merged vertex order of [`crate::load_mesh`] on the
 /// same file (instances in scene order, then primitives, then vertices), so whatever was
 /// computed on the loaded mesh is written back where it belongs. Written atomically.
@@ -152,9 +154,116 @@ pub fn write_gltf_with(
     bake_primitives(&src, &rig, &mut root, bake, &mut out)?;
     let bin_len = out.bin.len().next_multiple_of(4);
     out.bin.resize(bin_len, 0);
-    root["buffers"] = json!([{ "byteLength": bin_len }]);
-    write_container(output, &root, bin_len, |w| w.write_all(&out.bin))?;
+    if is_text_gltf(output) {
+        write_text(input, output, &mut root, &out.bin)?;
+    } else {
+        root["buffers"] = json!([{ "byteLength": bin_len }]);
+        write_container(output, &root, bin_len, |w| w.write_all(&out.bin))?;
+    }
     Ok(out.report)
+}
+
+/// Whether `path` names a JSON `.gltf` (else a `.glb` is written).
+fn is_text_gltf(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf"))
+}
+
+/// The buffer file a `.gltf` output `output` gets: its name with `.bin`, every character
+/// outside `A–Z a–z 0–9 . _ -` replaced by `_`, so that its URI needs no percent-encoding
+/// (readers differ on decoding it: trimesh does not).
+pub fn text_gltf_buffer(output: &Path) -> std::path::PathBuf {
+    let stem = output
+        .file_stem()
+        .map(|s| s.to_string_lossy())
+        .unwrap_or_default();
+    let safe: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-') {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    output.with_file_name(format!("{safe}.bin"))
+}
+
+/// Writes `root` as `output` (`.gltf`, JSON) with its one buffer `bin` in
+/// [`text_gltf_buffer`]`(output)` beside it, the buffer first so that
+/// the JSON never names a missing file; both atomically, the buffer removed again when the
+/// JSON cannot be written. Refused when the buffer file is one the input reads (its own buffer
+/// or an image), which the bake would destroy.
+fn write_text(
+    input: &Path,
+    output: &Path,
+    root: &mut Value,
+    bin: &[u8],
+) -> Result<(), MeshIoError> {
+    let bin_path = text_gltf_buffer(output);
+    let name = bin_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if let Ok(target) = std::fs::canonicalize(&bin_path) {
+        let base = input.parent().unwrap_or(Path::new("."));
+        let json = source_json(input)?;
+        for list in ["buffers", "images"] {
+            for (i, uri) in referenced_files(&json, list) {
+                let file = base.join(uri);
+                if std::fs::canonicalize(&file).is_ok_and(|f| f == target) {
+                    return Err(gltf_error(
+                        output,
+                        format!("{list}[{i}].uri"),
+                        format!(
+                            "the output's buffer {} is a file the input reads; name the output \
+                             differently",
+                            bin_path.display()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    root["buffers"] = json!([{ "byteLength": bin.len(), "uri": name }]);
+    let text = serde_json::to_vec_pretty(root)
+        .map_err(|e| gltf_error(output, "file", format!("cannot serialize the JSON: {e}")))?;
+    atomic_out::write_bytes(&bin_path, bin)?;
+    if let Err(e) = atomic_out::write_bytes(output, &text) {
+        let _ = std::fs::remove_file(&bin_path);
+        return Err(e.into());
+    }
+    Ok(())
+}
+
+/// The input's JSON (a `.gltf` file, or a `.glb`'s JSON chunk) as a tree.
+fn source_json(input: &Path) -> Result<Value, MeshIoError> {
+    let raw = input_guard::read_regular(input).map_err(|e| MeshIoError::io(input, "read", e))?;
+    let bytes = source::glb_json_chunk(&raw)
+        .filter(|_| raw.starts_with(b"glTF"))
+        .unwrap_or(&raw[..]);
+    serde_json::from_slice(bytes)
+        .map_err(|e| gltf_error(input, "file", format!("cannot parse the JSON: {e}")))
+}
+
+/// The decoded relative file URIs of the top-level array `list` (`buffers`, `images`), with
+/// their indices; `data:` URIs skipped.
+fn referenced_files(root: &Value, list: &str) -> Vec<(usize, String)> {
+    root.get(list)
+        .and_then(Value::as_array)
+        .into_iter()
+        .flatten()
+        .enumerate()
+        .filter_map(|(i, item)| {
+            let uri = item.get("uri")?.as_str()?;
+            (!uri.starts_with("data:"))
+                .then(|| source::percent_decode(uri))
+                .flatten()
+                .map(|u| (i, u))
+        })
+        .collect()
 }
 
 use std::io::Write as _;

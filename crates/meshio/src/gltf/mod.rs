@@ -28,7 +28,8 @@ use rayon::prelude::*;
 
 pub use accessor::MAX_VIEWLESS_ELEMENTS;
 pub use augment::{
-    BakeValues, ColourChannel, DoubleSided, GltfBake, GltfBakeReport, write_gltf_with,
+    BakeValues, ColourChannel, DoubleSided, GltfBake, GltfBakeReport, text_gltf_buffer,
+    write_gltf_with,
 };
 use rig::Rig;
 use sampler::Clip;

@@ -281,7 +281,7 @@ pub(super) fn glb_json_chunk(raw: &[u8]) -> Option<&[u8]> {
 }
 
 /// Decodes `%XX` escapes; `None` for a malformed escape or non-UTF-8 result.
-fn percent_decode(s: &str) -> Option<String> {
+pub(super) fn percent_decode(s: &str) -> Option<String> {
     let bytes = s.as_bytes();
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;

@@ -628,3 +628,59 @@ fn per_face_values_are_the_ambient_term_at_the_centroids() {
     ]);
     assert!(!run.status.success());
 }
+
+/// `--out X.gltf`: the JSON and one `X.bin` beside it (a URI-safe name: `baked_quads.bin`), the
+/// same values as the `.glb` output, loadable again; a buffer name that is the input's own
+/// buffer is refused before anything is written.
+#[test]
+fn a_gltf_output_writes_its_buffer_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = two_quads(dir.path(), 0.3, "tex.png");
+    let glb = dir.path().join("baked.glb");
+    let gltf = dir.path().join("baked quads.gltf");
+    for out in [&glb, &gltf] {
+        bake_ok(&["bake", text(&input), "--out", text(out), "--level", "2"]);
+    }
+    let bin_path = dir.path().join("baked_quads.bin");
+    let root: Value = serde_json::from_slice(&std::fs::read(&gltf).unwrap()).unwrap();
+    let bin = std::fs::read(&bin_path).unwrap();
+    assert_eq!(
+        root["buffers"],
+        json!([{ "byteLength": bin.len(), "uri": "baked_quads.bin" }])
+    );
+    let (glb_root, glb_bin) = read_glb(&glb);
+    assert_eq!(bin, glb_bin, "the .bin is the .glb's BIN chunk");
+    for mesh in 0..2 {
+        assert_eq!(
+            attribute_values(&root, &bin, mesh, "COLOR_0"),
+            attribute_values(&glb_root, &glb_bin, mesh, "COLOR_0"),
+        );
+    }
+    let (reloaded, _) = meshio::load_mesh(&gltf, &meshio::LoadOptions::default()).unwrap();
+    let (original, _) = meshio::load_mesh(&input, &meshio::LoadOptions::default()).unwrap();
+    assert_eq!(reloaded.positions, original.positions);
+    assert_eq!(reloaded.triangles, original.triangles);
+    if let Some(report) = test_data::validate_gltf(&gltf) {
+        // The test's image is not a decodable PNG; only its errors may remain.
+        let glb_report = test_data::validate_gltf(&glb).unwrap();
+        let errors = |s: &str| s.split("\"errors\":").nth(1).map(|t| t[..2].to_owned());
+        assert!(errors(&report.summary).is_some(), "{}", report.summary);
+        assert_eq!(
+            errors(&report.summary),
+            errors(&glb_report.summary),
+            "{}",
+            report.summary
+        );
+    }
+
+    // `quads.GLTF` would write `quads.bin`, the input's own buffer.
+    let clash = dir.path().join("quads.GLTF");
+    let before = std::fs::read(dir.path().join("quads.bin")).unwrap();
+    let run = cli(&["bake", text(&input), "--out", text(&clash), "--level", "1"]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(stderr.contains("buffers[0].uri"), "{stderr}");
+    assert!(stderr.contains("a file the input reads"), "{stderr}");
+    assert!(!clash.exists());
+    assert_eq!(std::fs::read(dir.path().join("quads.bin")).unwrap(), before);
+}
