@@ -14,7 +14,8 @@
 //!   **linear** vertex colour in the chosen channel (`COLOR_0` RGB by default, `COLOR_0.a` over
 //!   the existing colour, or `COLOR_1`), `_RADIANCE` (`VEC3` float, unclamped, a white
 //!   Lambertian surface: c_i = (1/π) Σ_j M_ij I_j ω_j) under `--env`/`--sky`, `_BENT_NORMAL`
-//!   with `--bent-normals`; materials double-sided per `--two-sided` (auto: primitives with a
+//!   with `--bent-normals`, `_AO_BACK` (a_i of the back side, normals flipped) with
+//!   `--back-side`; materials double-sided per `--two-sided` (auto: primitives with a
 //!   border edge, i.e. open surfaces such as cloth); primitives without a material get a
 //!   non-metallic rough one.
 //! - `.obj` → `.obj`: the file's lines unchanged except each `v x y z` line, which gets the
@@ -99,6 +100,11 @@ pub struct BakeArgs {
     /// Also write `_BENT_NORMAL` (glTF): the cosine-weighted mean open direction.
     #[arg(long)]
     bent_normals: bool,
+    /// Also bake the back side (normals flipped: what the inside of a garment sees) as the
+    /// scalar `_AO_BACK` (glTF; a shader picks it for back faces). The front values are
+    /// unchanged; the visibility work doubles.
+    #[arg(long)]
+    back_side: bool,
     /// Also write a_f per triangle (at its centroid, about its face normal) as f32 [T] .npy,
     /// triangles in the loaded mesh's order (polygons fan-triangulated in place; NaN for a
     /// degenerate triangle).
@@ -231,6 +237,14 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         // Its buffer file beside it must not be the input either.
         super::refuse_overwriting_input(&meshio::text_gltf_buffer(&args.out), &[input])?;
     }
+    if args.back_side && kind != Kind::Gltf {
+        return Err(invalid(
+            &args.out,
+            "--back-side writes `_AO_BACK` into a glTF; OBJ and PLY colours and VATs hold one \
+             side"
+                .to_owned(),
+        ));
+    }
     if let Some(path) = &args.per_face {
         super::refuse_overwriting_input(path, &[input])?;
         if vat || lower_extension(path).as_deref() != Some("npy") {
@@ -287,11 +301,10 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         meshio::NormalWeighting::Angle,
     );
     let n = mesh.positions.len();
-    let mut objects = vec![world_object(
-        mesh.positions.clone(),
-        normals,
-        mesh.triangles.clone(),
-    )];
+    let mut asset = world_object(mesh.positions.clone(), normals, mesh.triangles.clone());
+    // Two-sided: the stage adds rows with flipped normals.
+    asset.two_sided = args.back_side;
+    let mut objects = vec![asset];
     if args.per_face.is_some() {
         // Triangle centroids as receivers without triangles of their own: rows after the
         // vertices', the same engine and rays.
@@ -310,8 +323,12 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
     let millis = t.elapsed().as_secs_f64() * 1e3;
     step.finish_and_clear();
     let matrix = visibility.matrix();
-    let mut ambient = matrix.ambient();
-    let per_face = ambient.split_off(n);
+    let all = matrix.ambient();
+    let rows = |object: usize| visibility.rows(object).cloned().unwrap_or((0..0, None));
+    let (front, back) = rows(0);
+    let ambient = all[front.clone()].to_vec();
+    let ambient_back = back.map(|b| all[b].to_vec());
+    let per_face = all[rows(1).0].to_vec();
     if let Some(path) = &args.per_face {
         meshio::write_npy_f32(path, &[per_face.len()], &per_face)?;
     }
@@ -320,20 +337,18 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         Some(env) => {
             let light = cloth_vis::inputs::light_directions(&scene, env)?.0.1;
             Some(
-                shadowed_radiance(matrix, &sphere, &light)?
-                    .into_iter()
-                    .take(n)
+                shadowed_radiance(matrix, &sphere, &light)?[front.clone()]
+                    .iter()
+                    .copied()
                     .map(finite)
                     .collect(),
             )
         }
         None => None,
     };
-    let bent = args.bent_normals.then(|| {
-        let mut bent = matrix.bent_normals();
-        bent.truncate(n);
-        bent
-    });
+    let bent = args
+        .bent_normals
+        .then(|| matrix.bent_normals()[front.clone()].to_vec());
     let mut gltf = None;
     match kind {
         Kind::Gltf => {
@@ -348,6 +363,13 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
             }
             if let Some(b) = &bent {
                 attributes.push(("_BENT_NORMAL".to_owned(), BakeValues::Vec3(b)));
+            }
+            // Unused vertices (NaN) get 1, as in the colour; glTF forbids NaN.
+            let back_values: Option<Vec<f32>> = ambient_back
+                .as_ref()
+                .map(|b| b.iter().map(|a| linear(*a)).collect());
+            if let Some(b) = &back_values {
+                attributes.push(("_AO_BACK".to_owned(), BakeValues::Scalar(b)));
             }
             let request = GltfBake {
                 colour: Some((channel, &ambient)),

@@ -684,3 +684,61 @@ fn a_gltf_output_writes_its_buffer_beside_it() {
     assert!(!clash.exists());
     assert_eq!(std::fs::read(dir.path().join("quads.bin")).unwrap(), before);
 }
+
+/// `--back-side`: `_AO_BACK` is a_i with the normals flipped. The two quads mirror each other
+/// about the plane between them, and the lightsphere is symmetric under y → −y, so the upper
+/// quad's underside sees exactly what the lower quad's top sees, and the lower quad's underside
+/// is as open as the upper quad's top. The front values are those of a bake without the flag.
+#[test]
+fn the_back_side_mirrors_the_front_of_the_facing_quad() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = two_quads(dir.path(), 0.3, "tex.png");
+    let (plain, both) = (dir.path().join("plain.glb"), dir.path().join("both.glb"));
+    let common = ["--level", "2", "--backend", "cpu"];
+    bake_ok(&[&["bake", text(&input), "--out", text(&plain)], &common[..]].concat());
+    bake_ok(
+        &[
+            &["bake", text(&input), "--out", text(&both), "--back-side"],
+            &common[..],
+        ]
+        .concat(),
+    );
+    let (root, bin) = read_glb(&both);
+    let (plain_root, plain_bin) = read_glb(&plain);
+    for mesh in 0..2 {
+        assert_eq!(
+            attribute_values(&root, &bin, mesh, "COLOR_0"),
+            attribute_values(&plain_root, &plain_bin, mesh, "COLOR_0"),
+            "mesh {mesh}: the front changed"
+        );
+    }
+    let front = |mesh| -> Vec<f32> {
+        attribute_values(&root, &bin, mesh, "COLOR_0")
+            .chunks(3)
+            .map(|c| c[0])
+            .collect()
+    };
+    let back = |mesh| attribute_values(&root, &bin, mesh, "_AO_BACK");
+    let (lower, upper) = (0, 1);
+    for (a, b) in back(upper).iter().zip(front(lower)) {
+        assert!(
+            (a - b).abs() <= 1e-6,
+            "upper underside {a} vs lower top {b}"
+        );
+    }
+    for (a, b) in back(lower).iter().zip(front(upper)) {
+        assert!(
+            (a - b).abs() <= 1e-6,
+            "lower underside {a} vs upper top {b}"
+        );
+    }
+    assert!(back(upper).iter().all(|a| *a < 0.7), "{:?}", back(upper));
+    // Only where a glTF can carry it.
+    let obj = dir.path().join("x.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n").unwrap();
+    let out = dir.path().join("y.obj");
+    let run = cli(&["bake", text(&obj), "--out", text(&out), "--back-side"]);
+    assert!(!run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("_AO_BACK"));
+    assert!(!out.exists());
+}
