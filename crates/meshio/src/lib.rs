@@ -23,7 +23,7 @@
 //! | `.ply` (ASCII, binary LE/BE; faces or `tristrips`) | ✓ | one frame |
 //! | `.obj` | ✓ | one frame |
 //! | folder of numbered `.obj` frames | | ✓ (numeric order, parallel parse) |
-//! | `.gltf` / `.glb` (also `KHR_mesh_quantization`, `EXT_meshopt_compression`: gltfpack) | rest pose of the scene | skinning + morph targets sampled at a frame rate |
+//! | `.gltf` / `.glb` (also `KHR_mesh_quantization`, `EXT_`/`KHR_meshopt_compression`: gltfpack) | rest pose of the scene | skinning + morph targets sampled at a frame rate |
 //! | `.npy` `[F, V, 3]` f32/f64 | | ✓ (triangles from [`AnimationOptions::topology`]) |
 //! | `.pc2`, `.mdd` point caches | | ✓ (triangles from [`AnimationOptions::topology`]) |
 //!

@@ -108,6 +108,18 @@ pub struct GltfValidation {
     pub summary: String,
 }
 
+/// The folder of the npm packages the tests use (`.ci/run` installs them under
+/// `target/gltf-validator`; [`GLTF_VALIDATOR_ENV`] overrides it).
+fn node_modules() -> PathBuf {
+    std::env::var(GLTF_VALIDATOR_ENV).map_or_else(
+        |_| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                .join("../../target/gltf-validator/node_modules")
+        },
+        PathBuf::from,
+    )
+}
+
 /// Runs the Khronos glTF validator (node + the npm package `gltf-validator`) on `path`.
 ///
 /// # Panics
@@ -116,13 +128,7 @@ pub struct GltfValidation {
 /// `None`.
 #[track_caller]
 pub fn validate_gltf(path: &std::path::Path) -> Option<GltfValidation> {
-    let modules = std::env::var(GLTF_VALIDATOR_ENV).map_or_else(
-        |_| {
-            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-                .join("../../target/gltf-validator/node_modules")
-        },
-        PathBuf::from,
-    );
+    let modules = node_modules();
     if !modules.join("gltf-validator").is_dir() {
         return skip(&format!(
             "the glTF validator is not installed in {} (npm install --prefix target/gltf-validator gltf-validator)",
@@ -160,13 +166,7 @@ pub fn validate_gltf(path: &std::path::Path) -> Option<GltfValidation> {
 /// fails: the test cannot do what it means to.
 #[track_caller]
 pub fn gltfpack(args: &[&std::ffi::OsStr]) -> Option<()> {
-    let modules = std::env::var(GLTF_VALIDATOR_ENV).map_or_else(
-        |_| {
-            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-                .join("../../target/gltf-validator/node_modules")
-        },
-        PathBuf::from,
-    );
+    let modules = node_modules();
     let cli = modules.join("gltfpack/cli.js");
     if !cli.is_file() {
         return skip(&format!(
@@ -188,4 +188,72 @@ pub fn gltfpack(args: &[&std::ffi::OsStr]) -> Option<()> {
         String::from_utf8_lossy(&output.stderr)
     );
     Some(())
+}
+
+/// Decodes every meshopt-compressed buffer view (either extension) of the `.glb` at `path`
+/// with meshoptimizer's own decoder (the npm package `meshoptimizer`, installed beside the
+/// validator by `.ci/run`): (view index, its `count × byteStride` decoded bytes) per view.
+///
+/// # Panics
+/// When the package is missing and [`in_ci`] is true (through [`skip`]), or when the decoder
+/// fails on the file.
+#[track_caller]
+pub fn meshopt_reference_decode(path: &std::path::Path) -> Option<Vec<(usize, Vec<u8>)>> {
+    let modules = node_modules();
+    if !modules.join("meshoptimizer").is_dir() {
+        return skip(&format!(
+            "meshoptimizer's decoder is not installed in {} (npm install --prefix target/gltf-validator meshoptimizer)",
+            modules.display()
+        ));
+    }
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("js/meshopt-decode.cjs");
+    let output = match std::process::Command::new("node")
+        .arg(&script)
+        .arg(path)
+        .env("NODE_PATH", &modules)
+        .output()
+    {
+        Ok(output) => output,
+        Err(e) => return skip(&format!("node cannot run ({e}); install Node.js")),
+    };
+    assert!(
+        output.status.success(),
+        "meshoptimizer's decoder failed on {}: {}",
+        path.display(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let views: Vec<serde_json::Value> = serde_json::from_slice(&output.stdout)
+        .unwrap_or_else(|e| panic!("the reference decoder's output is not JSON: {e}"));
+    Some(
+        views
+            .iter()
+            .map(|v| {
+                let view = v["view"].as_u64().expect("view index") as usize;
+                let bytes = base64_decode(v["bytes"].as_str().expect("base64 bytes"));
+                (view, bytes)
+            })
+            .collect(),
+    )
+}
+
+/// Standard base64 (with padding) to bytes.
+fn base64_decode(text: &str) -> Vec<u8> {
+    let value = |c: u8| match c {
+        b'A'..=b'Z' => u32::from(c - b'A'),
+        b'a'..=b'z' => u32::from(c - b'a') + 26,
+        b'0'..=b'9' => u32::from(c - b'0') + 52,
+        b'+' => 62,
+        b'/' => 63,
+        _ => panic!("not base64: {c}"),
+    };
+    let mut out = Vec::with_capacity(text.len() / 4 * 3);
+    for group in text.as_bytes().chunks(4) {
+        let data: Vec<u8> = group.iter().copied().filter(|&c| c != b'=').collect();
+        let bits = data
+            .iter()
+            .enumerate()
+            .fold(0u32, |acc, (k, &c)| acc | value(c) << (18 - 6 * k));
+        out.extend(&bits.to_be_bytes()[1..data.len()]);
+    }
+    out
 }

@@ -348,13 +348,14 @@ fn check_values(src: &GltfSource, rig: &Rig, bake: &GltfBake<'_>) -> Result<(), 
 }
 
 /// Copies every buffer into the output's BIN and re-points the buffer views at buffer 0.
-/// `EXT_meshopt_compression` views were decoded into their fallback buffer on loading: they are
-/// written decoded (the extension dropped; gltfpack compresses the result again if wanted).
+/// Meshopt-compressed views (EXT or KHR) were decoded into their fallback buffer on loading:
+/// they are written decoded (the extension dropped; gltfpack compresses the result again if
+/// wanted).
 fn merge_buffers(src: &GltfSource, root: &mut Value, out: &mut Output) {
     let offsets: Vec<usize> = src.buffers.iter().map(|b| out.append(b)).collect();
     for list in ["extensionsUsed", "extensionsRequired"] {
         if let Some(names) = root.get_mut(list).and_then(Value::as_array_mut) {
-            names.retain(|n| n != "EXT_meshopt_compression");
+            names.retain(|n| !super::meshopt::EXTENSIONS.iter().any(|e| n == e));
             if names.is_empty() {
                 root.as_object_mut().map(|o| o.remove(list));
             }
@@ -363,7 +364,9 @@ fn merge_buffers(src: &GltfSource, root: &mut Value, out: &mut Output) {
     if let Some(views) = root.get_mut("bufferViews").and_then(Value::as_array_mut) {
         for view in views {
             if let Some(extensions) = view.get_mut("extensions").and_then(Value::as_object_mut) {
-                extensions.remove("EXT_meshopt_compression");
+                for name in super::meshopt::EXTENSIONS {
+                    extensions.remove(name);
+                }
                 if extensions.is_empty() {
                     view.as_object_mut().map(|o| o.remove("extensions"));
                 }

@@ -1,23 +1,38 @@
-//! `EXT_meshopt_compression` (gltfpack `-c`/`-cc`): buffer views stored compressed by
+//! `EXT_meshopt_compression` (gltfpack `-c`/`-cc`) and its ratified form
+//! `KHR_meshopt_compression` (gltfpack `-ce khr`): buffer views stored compressed by
 //! meshoptimizer's codecs, decoded into their fallback buffer before any accessor is read
-//! (glTF extension spec, Khronos `extensions/2.0/Vendor/EXT_meshopt_compression`).
+//! (Khronos `extensions/2.0/Vendor/EXT_meshopt_compression` and
+//! `extensions/2.0/Khronos/KHR_meshopt_compression`).
 //!
 //! A compressed view names its source (`buffer`, `byteOffset`, `byteLength` in the
 //! extension), its `count` of elements of `byteStride` bytes, a `mode` (`ATTRIBUTES`: the vertex
-//! codec; `TRIANGLES`: the index codec; `INDICES`: index sequences, not decoded here — only
-//! point and line primitives use them and those are refused anyway) and an optional `filter`
-//! applied after decoding: `OCTAHEDRAL` (unit vectors as 8/16-bit octahedral x, y), `QUATERNION`
-//! (16-bit, the largest component rebuilt), `EXPONENTIAL` (24-bit mantissa, 8-bit exponent per
-//! 32-bit float). The decoded bytes go to the view's own `buffer`/`byteOffset`, the "fallback"
-//! buffer, which a compressed file leaves without data (allocated here, zero-filled, within the
-//! file's decode budget). The codecs are meshoptimizer's (`meshopt::decode_vertex_buffer`,
-//! `decode_index_buffer`; safe for untrusted input); the filters are written here after the
-//! extension's Appendix B.
+//! codec, versions 0 and 1 — the KHR form allows 1; `TRIANGLES`: the index codec; `INDICES`:
+//! index sequences, not decoded here — gltfpack writes them only for point and line primitives,
+//! which this reader refuses with their own message) and an optional `filter` applied after
+//! decoding: `OCTAHEDRAL` (unit vectors as 8/16-bit octahedral x, y), `QUATERNION` (16-bit, the
+//! largest component rebuilt), `EXPONENTIAL` (24-bit mantissa, 8-bit exponent per 32-bit
+//! float), and in the KHR form `COLOR` (YCoCg with the alpha's top bit marking the bit depth).
+//! The decoded bytes go to the view's own `buffer`/`byteOffset`, the "fallback" buffer, which a
+//! compressed file leaves without data (allocated here, zero-filled, within the file's decode
+//! budget). The codecs are meshoptimizer's (`meshopt::decode_vertex_buffer`,
+//! `decode_index_buffer`, meshoptimizer 0.25; safe for untrusted input); the filters are written
+//! here after the extensions' filter appendix and meshoptimizer's scalar reference
+//! (`vertexfilter.cpp`).
 
 use serde_json::Value;
 
 use super::source::gltf_error;
 use crate::MeshIoError;
+
+/// The two names of the extension; a file uses one of them.
+pub(super) const EXTENSIONS: [&str; 2] = ["EXT_meshopt_compression", "KHR_meshopt_compression"];
+
+/// The meshopt extension object of `value`'s `extensions` (either name) and its name.
+fn extension(value: &Value) -> Option<(&'static str, &Value)> {
+    EXTENSIONS
+        .iter()
+        .find_map(|name| Some((*name, value.get("extensions")?.get(name)?)))
+}
 
 /// Element bytes the vertex codec decodes, as a type of that size.
 #[derive(Clone, Copy)]
@@ -154,6 +169,61 @@ fn filter_exponential(data: &mut [u8], stride: usize) -> Result<(), String> {
     Ok(())
 }
 
+/// Colours as Y, Co, Cg (Co and Cg signed) and alpha whose highest set bit marks the bit depth
+/// K of the encoding: R = Y + Co − Cg, G = Y + Cg, B = Y − Co − Cg, alpha widened by one bit,
+/// all scaled by (2^bits − 1)/(2^K − 1) in f32 and rounded to nearest, ties to even (as
+/// meshoptimizer's SIMD `decodeFilterColorSimd8/16` do); stored modulo 2^bits.
+fn filter_color(data: &mut [u8], stride: usize) -> Result<(), String> {
+    fn decode(y: i32, co: i32, cg: i32, alpha: i32, max: f32) -> [i32; 4] {
+        let mut scale_bits = alpha;
+        for shift in [1, 2, 4, 8] {
+            scale_bits |= scale_bits >> shift;
+        }
+        let (r, g, b) = (y + co - cg, y + cg, y - co - cg);
+        let a = ((alpha << 1) & scale_bits) | (alpha & 1);
+        let ss = max / scale_bits as f32;
+        // Nearest, ties to even: meshoptimizer's SIMD decoders (its WebAssembly build snaps
+        // x + 1.5·2^23); its scalar fallback's int(x + 0.5f) differs by one in rare ties.
+        [r, g, b, a].map(|v| (v as f32 * ss).round_ties_even() as i32)
+    }
+    match stride {
+        4 => {
+            for e in data.chunks_exact_mut(4) {
+                let v = decode(
+                    i32::from(e[0]),
+                    i32::from(e[1] as i8),
+                    i32::from(e[2] as i8),
+                    i32::from(e[3]),
+                    255.0,
+                );
+                for k in 0..4 {
+                    e[k] = v[k] as u8;
+                }
+            }
+            Ok(())
+        }
+        8 => {
+            for e in data.chunks_exact_mut(8) {
+                let c = |k: usize| u16::from_le_bytes([e[2 * k], e[2 * k + 1]]);
+                let v = decode(
+                    i32::from(c(0)),
+                    i32::from(c(1) as i16),
+                    i32::from(c(2) as i16),
+                    i32::from(c(3)),
+                    65535.0,
+                );
+                for k in 0..4 {
+                    e[2 * k..2 * k + 2].copy_from_slice(&(v[k] as u16).to_le_bytes());
+                }
+            }
+            Ok(())
+        }
+        _ => Err(format!(
+            "the COLOR filter needs byteStride 4 or 8, not {stride}"
+        )),
+    }
+}
+
 /// The fallback buffers of `root` (extension `fallback: true`): their index and byte length.
 pub(super) fn fallback_buffers(root: &Value) -> Vec<(usize, usize)> {
     root["buffers"]
@@ -161,12 +231,13 @@ pub(super) fn fallback_buffers(root: &Value) -> Vec<(usize, usize)> {
         .into_iter()
         .flatten()
         .enumerate()
-        .filter(|(_, b)| b["extensions"]["EXT_meshopt_compression"]["fallback"] == true)
+        .filter(|(_, b)| extension(b).is_some_and(|(_, e)| e["fallback"] == true))
         .map(|(i, b)| (i, b["byteLength"].as_u64().unwrap_or(0) as usize))
         .collect()
 }
 
-/// Decodes every compressed buffer view of `root` into its target buffer in `buffers`.
+/// Decodes every compressed buffer view of `root` (either extension) into its target buffer in
+/// `buffers`.
 ///
 /// # Errors
 /// [`MeshIoError::Gltf`] naming the buffer view: a field missing or out of range, a source or
@@ -182,11 +253,10 @@ pub(super) fn decode_views(
         .flatten()
         .enumerate()
     {
-        let ext = &view["extensions"]["EXT_meshopt_compression"];
-        if ext.is_null() {
+        let Some((name, ext)) = extension(view) else {
             continue;
-        }
-        let element = format!("bufferViews[{i}].extensions.EXT_meshopt_compression");
+        };
+        let element = format!("bufferViews[{i}].extensions.{name}");
         let err = |m: String| gltf_error(path, &element, m);
         let field = |v: &Value, name: &str| {
             v[name]
@@ -237,8 +307,14 @@ pub(super) fn decode_views(
             "OCTAHEDRAL" => filter_octahedral(&mut decoded, stride),
             "QUATERNION" => filter_quaternion(&mut decoded, stride),
             "EXPONENTIAL" => filter_exponential(&mut decoded, stride),
+            "COLOR" if name.starts_with("KHR") => filter_color(&mut decoded, stride),
             other => Err(format!(
-                "filter {other:?} is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL"
+                "filter {other:?} is not NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL{}",
+                if name.starts_with("KHR") {
+                    " or COLOR"
+                } else {
+                    ""
+                }
             )),
         }
         .map_err(&err)?;

@@ -91,13 +91,22 @@ pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes)
         .map_err(|e| gltf_error(path, "file", format!("cannot parse: {e}; is it glTF 2.0?")))?;
     validate(path, gltf.document.as_json())?;
-    // The raw JSON, for what the `gltf` crate does not model (EXT_meshopt_compression).
-    let json_bytes = if is_glb {
-        glb_json_chunk(&bytes).unwrap_or_default()
+    // The raw JSON, for what the `gltf` crate does not model (the meshopt extensions), parsed
+    // only when the file uses one of them.
+    let compressed = gltf
+        .document
+        .extensions_used()
+        .any(|e| super::meshopt::EXTENSIONS.contains(&e));
+    let raw: serde_json::Value = if compressed {
+        let json_bytes = if is_glb {
+            glb_json_chunk(&bytes).unwrap_or_default()
+        } else {
+            &bytes[..]
+        };
+        serde_json::from_slice(json_bytes).unwrap_or_default()
     } else {
-        &bytes[..]
+        serde_json::Value::Null
     };
-    let raw: serde_json::Value = serde_json::from_slice(json_bytes).unwrap_or_default();
     let fallbacks = super::meshopt::fallback_buffers(&raw);
     let fallback_bytes: u64 = fallbacks.iter().map(|(_, len)| *len as u64).sum();
     let fallback_budget = GLTF_DECODE_FLOOR
@@ -107,7 +116,7 @@ pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
             path,
             "buffers",
             format!(
-                "EXT_meshopt_compression fallback buffers declare {fallback_bytes} bytes, more \
+                "meshopt compression's fallback buffers declare {fallback_bytes} bytes, more \
                  than this file may decode to ({fallback_budget})"
             ),
         ));
@@ -160,7 +169,11 @@ pub(crate) fn open(path: &Path) -> Result<GltfSource, MeshIoError> {
 }
 
 /// Required extensions this reader decodes beyond what the `gltf` crate validates.
-pub const SUPPORTED_REQUIRED: [&str; 2] = ["KHR_mesh_quantization", "EXT_meshopt_compression"];
+pub const SUPPORTED_REQUIRED: [&str; 3] = [
+    "KHR_mesh_quantization",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
+];
 
 /// Runs the `gltf` crate's validation, after the checks that keep it from panicking.
 fn validate(path: &Path, root: &gltf::json::Root) -> Result<(), MeshIoError> {
@@ -186,11 +199,6 @@ fn validate(path: &Path, root: &gltf::json::Root) -> Result<(), MeshIoError> {
             "KHR_draco_mesh_compression" => {
                 "Draco-compressed geometry, which is not decoded here: export the file \
                  without Draco compression (Blender's glTF exporter: Compression off)"
-            }
-            "KHR_meshopt_compression" => {
-                "meshoptimizer-compressed buffers in the KHR form (its v1 codecs and colour \
-                 filter), which are not decoded here yet: write EXT_meshopt_compression \
-                 (gltfpack -c without -cx) or no compression"
             }
             _ => continue,
         };
