@@ -97,6 +97,18 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
     let kind = out_kind(&request.out, request.force)?;
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
     let (data, _) = read_cpca(&request.input)?;
+    let estimate = super::output_size::frames_bytes(
+        matches!(kind, OutKind::ObjFolder(_)),
+        data.frames(),
+        data.vertices(),
+        data.triangles().len(),
+    );
+    let levers = "write .npy instead of OBJ frames, or decode on the GPU where it is used";
+    if let Some(line) =
+        super::output_size::check(&request.out, "the output", estimate, levers, request.force)?
+    {
+        eprintln!("{line}");
+    }
     if kind == OutKind::Glb && data.frames() > meshio::MAX_GLB_ANIMATION_FRAMES {
         return Err(invalid(
             &request.out,
@@ -221,7 +233,8 @@ pub struct DecompressArgs {
     /// name (OBJ frames).
     #[arg(long)]
     out: PathBuf,
-    /// Replace an existing output folder that holds files, once the new frames are complete.
+    /// Replace an existing output folder that holds files, once the new frames are complete;
+    /// write an output estimated above 8 GiB.
     #[arg(long)]
     force: bool,
     /// Hide the progress bar.

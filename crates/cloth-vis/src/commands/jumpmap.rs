@@ -296,6 +296,18 @@ pub fn run_jumpmap(
             ),
         ));
     }
+    let estimate = super::output_size::frames_bytes(
+        matches!(kind, OutKind::ObjFolder(_)),
+        request.frames,
+        clip.vertex_count(),
+        clip.triangles.len(),
+    );
+    let levers = "generate fewer --frames per run";
+    if let Some(line) =
+        super::output_size::check(out, "the output", estimate, levers, request.force)?
+    {
+        eprintln!("{line}");
+    }
     if matches!(kind, OutKind::Vat) {
         let size = (request.frames, clip.vertex_count());
         super::vat_out::check(&request.input, out, &clip.triangles, size)?;
@@ -690,7 +702,8 @@ pub struct JumpmapArgs {
     /// Output: FILE.npy, FILE.glb or a folder name (OBJ frames).
     #[arg(long)]
     out: PathBuf,
-    /// Replace an existing output folder that holds files, once the new frames are complete.
+    /// Replace an existing output folder that holds files, once the new frames are complete;
+    /// write an output estimated above 8 GiB.
     #[arg(long)]
     force: bool,
     /// Most gigabytes of generated positions (frames × vertices × 12 bytes) held in memory.

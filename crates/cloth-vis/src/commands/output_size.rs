@@ -44,9 +44,36 @@ pub fn check(
     }))
 }
 
+/// Bytes of `frames` × `vertices` positions written as `.npy`/`.glb`/VAT (12 bytes a vertex)
+/// or as an OBJ folder (`obj`: about 40 bytes a `v x y z` line, plus the faces once per frame,
+/// `triangles` × ~24 bytes).
+pub fn frames_bytes(obj: bool, frames: usize, vertices: usize, triangles: usize) -> u64 {
+    let (frames, vertices, triangles) = (frames as u64, vertices as u64, triangles as u64);
+    if obj {
+        frames.saturating_mul(
+            vertices
+                .saturating_mul(40)
+                .saturating_add(triangles.saturating_mul(24)),
+        )
+    } else {
+        frames.saturating_mul(vertices.saturating_mul(12))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn frame_outputs_are_estimated_by_kind() {
+        // 1,000 frames of the chicken (3,030 vertices, 5,664 triangles).
+        assert_eq!(frames_bytes(false, 1000, 3030, 5664), 36_360_000);
+        assert_eq!(
+            frames_bytes(true, 1000, 3030, 5664),
+            1000 * (121_200 + 135_936)
+        );
+        assert_eq!(frames_bytes(true, usize::MAX, usize::MAX, 1), u64::MAX);
+    }
 
     #[test]
     fn the_bunny_at_level_7_is_refused_and_level_6_announced() {

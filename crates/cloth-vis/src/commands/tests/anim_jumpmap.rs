@@ -206,6 +206,25 @@ fn bad_requests_are_refused_before_writing() {
     r.memory_limit = (20 * vertices * 12) as u64;
     run_jumpmap(&r, None).unwrap();
     assert!(out.exists());
+    // Issue #18: an output estimated above 8 GiB is refused before the analysis unless
+    // --force, even when the memory limit allows it (an OBJ folder is ~3× the positions).
+    let folder = dir.path().join("frames");
+    let mut r = request(dir.path().join("clip"), folder.clone());
+    let frames_for = |bytes: u64, per_frame: u64| (bytes / per_frame + 1) as usize;
+    let (_, triangles) = {
+        let (clip, _) =
+            meshio::load_animation(&dir.path().join("clip"), &Default::default()).unwrap();
+        (clip.frames.len(), clip.triangles.len())
+    };
+    let per_frame = (vertices * 40 + triangles * 24) as u64;
+    r.frames = frames_for(crate::commands::output_size::REFUSE_BYTES, per_frame);
+    r.memory_limit = u64::MAX;
+    let e = run_jumpmap(&r, None).unwrap_err().to_string();
+    assert!(
+        e.contains("the output would be") && e.contains("--force"),
+        "{e}"
+    );
+    assert!(!folder.exists());
 }
 
 /// A GPU context, or `None` after the project's skip policy (fails under CI). Lavapipe wants
