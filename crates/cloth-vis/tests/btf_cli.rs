@@ -324,4 +324,66 @@ fn render_on_the_gpu_matches_the_cpu_reference_and_bad_requests_are_refused() {
         "{e}"
     );
     assert!(!bad.exists() && !jpg.exists());
+
+    // --up-axis z: a Z-up copy of a mesh (every point and the light turned by +90° about X,
+    // taking +Y to +Z) renders as the Y-up original does, the camera turned with it.
+    let grid = |turn: bool| -> String {
+        let mut obj = String::new();
+        let n = 12;
+        for j in 0..=n {
+            for i in 0..=n {
+                let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+                let (x, y, z) = (u - 0.5, 0.15 * (6.0 * u).sin() * (4.0 * v).cos(), v - 0.5);
+                let (x, y, z) = if turn { (x, -z, y) } else { (x, y, z) };
+                obj += &format!("v {x} {y} {z}\nvt {u} {v}\n");
+            }
+        }
+        for j in 0..n {
+            for i in 0..n {
+                let a = j * (n + 1) + i + 1;
+                let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
+                obj += &format!("f {a}/{a} {c}/{c} {b}/{b}\nf {b}/{b} {c}/{c} {d}/{d}\n");
+            }
+        }
+        obj
+    };
+    let images: Vec<image::RgbImage> = [(false, "y", "0.2,0.9,0.6"), (true, "z", "0.2,-0.6,0.9")]
+        .iter()
+        .map(|&(turn, axis, light)| {
+            let mesh = tmp.path().join(format!("grid-{axis}.obj"));
+            std::fs::write(&mesh, grid(turn)).unwrap();
+            let png = tmp.path().join(format!("grid-{axis}.png"));
+            let out = cli(&[
+                "btf",
+                "render",
+                text(&mesh),
+                "--btf",
+                text(&file),
+                "--light-dir",
+                light,
+                "--up-axis",
+                axis,
+                "--size",
+                "96x96",
+                "--cpu",
+                "--out",
+                text(&png),
+            ]);
+            assert!(out.status.success(), "{}", stderr(&out));
+            image::open(&png).unwrap().to_rgb8()
+        })
+        .collect();
+    let lit = images[0].pixels().filter(|p| p.0 != [0, 0, 0]).count();
+    assert!(lit > 1000, "the grid covers only {lit} pixels");
+    let diff: u64 = images[0]
+        .as_raw()
+        .iter()
+        .zip(images[1].as_raw())
+        .map(|(a, b)| u64::from(a.abs_diff(*b)))
+        .sum();
+    let mean = diff as f64 / images[0].as_raw().len() as f64;
+    assert!(
+        mean <= 0.5,
+        "the Z-up copy differs by {mean} codes on average"
+    );
 }

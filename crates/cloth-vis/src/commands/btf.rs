@@ -319,8 +319,12 @@ pub struct RenderRequest {
     pub light: RenderLight,
     /// Linear RGB radiance g of the light.
     pub radiance: Vec3,
-    /// Direction from the mesh towards the camera (the camera frames the mesh).
+    /// Direction from the mesh towards the camera (the camera frames the mesh), in a Y-up frame
+    /// turned onto `up_axis` with the camera's up.
     pub camera_direction: Vec3,
+    /// The mesh's up axis (z for Blender/CAD exports such as the Berkeley garments); lights
+    /// stay in the mesh's own coordinates.
+    pub up_axis: super::up_axis::UpAxis,
     /// Image size in pixels.
     pub size: [u32; 2],
     /// Texture repeats across the mesh's UV range.
@@ -460,10 +464,12 @@ pub fn run_render(
     let object = render_mesh(&request_.mesh)?;
     let (centre, radius) =
         render::bounding_sphere(object.positions.iter()).unwrap_or((Vec3::ZERO, 1.0));
+    let up = super::up_axis::up_axis_rotation(request_.up_axis).as_quat();
     let desc = cloth_vis::scene::CameraDesc {
         width: w,
         height: h,
-        direction: request_.camera_direction.to_array(),
+        direction: (up * request_.camera_direction).to_array(),
+        up: (up * Vec3::Y).to_array(),
         ..cloth_vis::scene::CameraDesc::default()
     };
     let framed = cloth_vis::camera::resolve(&desc, centre, radius);
@@ -630,9 +636,14 @@ pub struct RenderArgs {
     /// Linear RGB radiance of the light.
     #[arg(long, value_name = "R,G,B", value_parser = super::parse::vec3, default_value = "1,1,1")]
     radiance: Vec3,
-    /// Direction from the mesh towards the camera, which frames the mesh.
+    /// Direction from the mesh towards the camera, which frames the mesh (Y-up; turned with
+    /// --up-axis).
     #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, default_value = "0.55,0.45,1")]
     camera_dir: Vec3,
+    /// The mesh's up axis: the camera turns onto it (z for Blender/CAD exports such as the
+    /// Berkeley garments); --light-dir/--light-pos stay in the mesh's coordinates.
+    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
+    up_axis: super::up_axis::UpAxis,
     /// Image size.
     #[arg(long, value_name = "WxH", value_parser = super::parse::size, default_value = "512x512")]
     size: [u32; 2],
@@ -671,6 +682,7 @@ impl RenderArgs {
             light,
             radiance: self.radiance,
             camera_direction: self.camera_dir,
+            up_axis: self.up_axis,
             size: self.size,
             uv_scale: self.uv_scale,
             beside_plain: self.beside_plain,
