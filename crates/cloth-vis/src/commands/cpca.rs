@@ -336,6 +336,7 @@ pub fn run_stats(original: &Path, cpca: &Path) -> Result<StatsSummary, Error> {
             clusters_png: None,
             error_plot: None,
             frontier: false,
+            progress: false,
         },
         None,
     )
@@ -360,6 +361,8 @@ pub struct StatsRequest {
     pub error_plot: Option<PathBuf>,
     /// Also search the frontier at the file's rate ([`FrontierPosition`]).
     pub frontier: bool,
+    /// Show a spinner naming each step (stderr, terminals only).
+    pub progress: bool,
 }
 
 /// Runs `stats` (bpvf, d_a, worst d_f) and writes the pictures `request` asks for. `gpu` is needed
@@ -396,11 +399,13 @@ pub fn run_stats_with_pictures(
                 .to_owned(),
         ));
     }
+    let step = super::spinner(request.progress, format!("loading {}", original.display()));
     let (data, file_bytes) = read_cpca(cpca)?;
     let (clip, _) = meshio::load_animation(
         original,
         &super::animation_options(&request.clip, request.topology.as_deref()),
     )?;
+    step.set_message("decoding and measuring d_a, d_f".to_owned());
     let (f, v) = (
         clip.frames.len(),
         clip.frames.first().map_or(0, std::vec::Vec::len),
@@ -429,6 +434,7 @@ pub fn run_stats_with_pictures(
         let chart = error_chart(&distortion, cpca);
         atomic_out::write_with(svg, |w| w.write_all(chart.as_bytes()))?;
     }
+    step.set_message("searching the rate-distortion frontier at the file's rate".to_owned());
     let frontier = request
         .frontier
         .then(|| {
@@ -437,6 +443,7 @@ pub fn run_stats_with_pictures(
         })
         .transpose()
         .map_err(|e| anim_error(original, e))?;
+    step.finish_and_clear();
     Ok(StatsSummary {
         rate: data.rate(),
         file_bytes,
@@ -599,6 +606,9 @@ pub struct StatsArgs {
     /// 170-frame clip).
     #[arg(long)]
     frontier: bool,
+    /// Hide the progress spinner.
+    #[arg(long)]
+    quiet: bool,
 }
 
 impl StatsArgs {
@@ -616,6 +626,7 @@ impl StatsArgs {
             clusters_png: self.clusters_png,
             error_plot: self.error_plot,
             frontier: self.frontier,
+            progress: !self.quiet,
         };
         super::print_line(&run_stats_with_pictures(&request, gpu.as_ref())?.line())
     }

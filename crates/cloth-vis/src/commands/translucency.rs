@@ -180,6 +180,9 @@ pub struct TranslucencyArgs {
     /// PNG exposure in stops (default: automatic).
     #[arg(long, value_name = "EV", allow_negative_numbers = true)]
     exposure: Option<f32>,
+    /// Hide the progress bars.
+    #[arg(long)]
+    quiet: bool,
 }
 
 impl TranslucencyArgs {
@@ -201,7 +204,7 @@ impl TranslucencyArgs {
         }
         let scene = self.scene()?;
         let options = RunOptions {
-            progress: true,
+            progress: !self.quiet,
             frames: self.frames,
             replace_output: self.force,
             ..RunOptions::default()

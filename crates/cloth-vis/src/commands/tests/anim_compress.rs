@@ -464,6 +464,7 @@ fn stats_draws_the_error_per_frame_and_the_clusters() {
         clusters_png: Some(dir.path().join("clusters.png")),
         error_plot: None,
         frontier: false,
+        progress: false,
     };
     let e = crate::commands::cpca::run_stats_with_pictures(&request, Some(&gpu)).unwrap_err();
     assert!(e.to_string().contains("triangles"), "{e}");

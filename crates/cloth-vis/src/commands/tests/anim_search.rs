@@ -176,6 +176,7 @@ fn stats_frontier_finds_a_file_compressed_with_too_few_components_off_the_fronti
             clusters_png: None,
             error_plot: None,
             frontier: true,
+            progress: false,
         },
         None,
     )
