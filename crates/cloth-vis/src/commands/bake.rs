@@ -46,8 +46,7 @@ use glam::Vec3;
 use meshio::{BakeValues, ColourChannel, DoubleSided, GltfBake};
 
 use super::invalid;
-use super::up_axis::UpAxis;
-use super::visibility::{load_environment, lower_extension, turned_environment};
+use super::visibility::lower_extension;
 
 /// What the input and output extensions ask for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -110,23 +109,8 @@ pub struct BakeArgs {
     /// degenerate triangle).
     #[arg(long, value_name = "FILE.npy")]
     per_face: Option<PathBuf>,
-    /// HDR environment (.hdr/.exr): also write `_RADIANCE` (glTF), unclamped.
-    #[arg(long, conflicts_with = "sky")]
-    env: Option<PathBuf>,
-    /// The procedural sky as the environment (see --env).
-    #[arg(long)]
-    sky: bool,
-    /// Rotate the environment by DEG degrees about the up axis.
-    #[arg(
-        long,
-        value_name = "DEG",
-        default_value_t = 0.0,
-        allow_negative_numbers = true
-    )]
-    env_rotation: f32,
-    /// The input's up axis (the environment's zenith turns onto it).
-    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
-    up_axis: UpAxis,
+    #[command(flatten)]
+    environment: super::env_args::EnvironmentArgs,
     /// A mesh whose triangles a point-cache input (.npy, .pc2, .mdd) takes (VAT output).
     #[arg(long, value_name = "MESH")]
     topology: Option<PathBuf>,
@@ -278,8 +262,7 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         }
     }
     scene.visibility.max_distance = args.max_distance;
-    let environment = load_environment(args.env.as_deref(), args.sky)?
-        .map(|env| turned_environment(env, args.up_axis, args.env_rotation));
+    let environment = args.environment.load_turned()?;
     let gpu = match scene.visibility.backend {
         VisibilityBackendDesc::Depth | VisibilityBackendDesc::Query => Some(
             gpu_context::GpuContext::new(&gpu_context::GpuOptions::default())?,

@@ -10,6 +10,7 @@ mod cpca_bits;
 mod cpca_decompress;
 mod cpca_figures;
 mod cpca_search;
+pub mod env_args;
 pub mod hemicube;
 pub mod inspect;
 pub mod jumpmap;

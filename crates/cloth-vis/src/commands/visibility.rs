@@ -655,22 +655,8 @@ pub struct VisibilityArgs {
     /// Depth-map side for the depth and query backends.
     #[arg(long, default_value_t = occlusion_gpu::DEFAULT_DEPTH_RESOLUTION)]
     depth_res: u32,
-    /// HDR environment (.hdr/.exr) for the colours of a .ply/.glb output and --render
-    /// (without --env or --sky: the grey ambient term a_i).
-    #[arg(long, conflicts_with = "sky")]
-    env: Option<PathBuf>,
-    /// Use the procedural sky as the environment (see --env).
-    #[arg(long)]
-    sky: bool,
-    /// Rotate the environment by DEG degrees about the up axis (+Y) relative to the object (rotated
-    /// look-ups of I_j; M is not recomputed). Needs --env or --sky.
-    #[arg(
-        long,
-        value_name = "DEG",
-        default_value_t = 0.0,
-        allow_negative_numbers = true
-    )]
-    env_rotation: f32,
+    #[command(flatten)]
+    environment: super::env_args::EnvironmentArgs,
     /// Output: .npy (a_i as f32 [N] or [F, N]; M as [N, k] or [F, N, k] with --matrix),
     /// .ply (one frame: colour, float `ao` = a_i, NaN for unused vertices) or .glb (one
     /// frame: linear float COLOR_0, float `_AO` = a_i, -1 for unused vertices).
@@ -698,10 +684,6 @@ pub struct VisibilityArgs {
     /// Rendered image size.
     #[arg(long, value_name = "WxH", value_parser = super::parse::size, default_value = DEFAULT_RENDER_SIZE)]
     render_size: [u32; 2],
-    /// The input's up axis: the environment's zenith and the render camera's up turn onto it
-    /// (z for Blender/CAD exports); the outputs stay in the input's frame.
-    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
-    up_axis: UpAxis,
     /// Hide the progress bar over the frames of an animation.
     #[arg(long)]
     quiet: bool,
@@ -713,7 +695,7 @@ pub struct VisibilityArgs {
 impl VisibilityArgs {
     /// Load the environment the flags name, compute, write; print the summary line.
     pub fn run(self) -> anyhow::Result<()> {
-        let environment = load_environment(self.env.as_deref(), self.sky)?;
+        let environment = self.environment.load()?;
         let backend = self.backend.as_deref().map(|b| match b {
             "cpu" => Backend::Cpu,
             "query" => Backend::Query,
@@ -737,7 +719,7 @@ impl VisibilityArgs {
             backend,
             depth_resolution: self.depth_res,
             environment,
-            env_rotation_deg: self.env_rotation,
+            env_rotation_deg: self.environment.env_rotation,
             out: self.out,
             matrix: self.matrix,
             frames: self.frames,
@@ -745,7 +727,7 @@ impl VisibilityArgs {
             exposure_ev: self.exposure,
             gamma: self.gamma,
             render_size: self.render_size,
-            up_axis: self.up_axis,
+            up_axis: self.environment.up_axis,
             progress: !self.quiet,
             force: self.force,
         };
