@@ -97,18 +97,10 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
     let kind = out_kind(&request.out, request.force)?;
     super::refuse_overwriting_input(&request.out, &[&request.input])?;
     let (data, _) = read_cpca(&request.input)?;
-    let estimate = super::output_size::frames_bytes(
-        matches!(kind, OutKind::ObjFolder(_)),
-        data.frames(),
-        data.vertices(),
-        data.triangles().len(),
-    );
+    let size = (data.frames(), data.vertices(), data.triangles().len());
     let levers = "write .npy instead of OBJ frames, or decode on the GPU where it is used";
-    if let Some(line) =
-        super::output_size::check(&request.out, "the output", estimate, levers, request.force)?
-    {
-        eprintln!("{line}");
-    }
+    let obj = matches!(kind, OutKind::ObjFolder(_));
+    super::output_size::check_frames(&request.out, obj, size, levers, request.force)?;
     if kind == OutKind::Glb && data.frames() > meshio::MAX_GLB_ANIMATION_FRAMES {
         return Err(invalid(
             &request.out,

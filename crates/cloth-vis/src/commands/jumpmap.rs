@@ -296,18 +296,12 @@ pub fn run_jumpmap(
             ),
         ));
     }
-    let estimate = super::output_size::frames_bytes(
+    let size = (request.frames, clip.vertex_count(), clip.triangles.len());
+    let (obj, levers) = (
         matches!(kind, OutKind::ObjFolder(_)),
-        request.frames,
-        clip.vertex_count(),
-        clip.triangles.len(),
+        "fewer --frames per run",
     );
-    let levers = "generate fewer --frames per run";
-    if let Some(line) =
-        super::output_size::check(out, "the output", estimate, levers, request.force)?
-    {
-        eprintln!("{line}");
-    }
+    super::output_size::check_frames(out, obj, size, levers, request.force)?;
     if matches!(kind, OutKind::Vat) {
         let size = (request.frames, clip.vertex_count());
         super::vat_out::check(&request.input, out, &clip.triangles, size)?;

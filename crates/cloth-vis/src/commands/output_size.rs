@@ -60,6 +60,24 @@ pub fn frames_bytes(obj: bool, frames: usize, vertices: usize, triangles: usize)
     }
 }
 
+/// [`check`] of a frames output ([`frames_bytes`]): the announcement printed on stderr.
+///
+/// # Errors
+/// As [`check`].
+pub fn check_frames(
+    path: &Path,
+    obj: bool,
+    (frames, vertices, triangles): (usize, usize, usize),
+    levers: &str,
+    force: bool,
+) -> Result<(), Error> {
+    let bytes = frames_bytes(obj, frames, vertices, triangles);
+    if let Some(line) = check(path, "the output", bytes, levers, force)? {
+        eprintln!("{line}");
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
