@@ -286,6 +286,18 @@ fn glb_contents(path: &Path) -> (HashMap<String, Vec<u8>>, Vec<CompressedView>) 
     (attributes, views)
 }
 
+/// `packed` written back by the bake writer with nothing added: every view decoded, the
+/// compression extension dropped; returns `plain`.
+fn write_decoded(packed: &Path, plain: &Path) -> std::path::PathBuf {
+    let nothing = meshio::GltfBake {
+        colour: None,
+        attributes: Vec::new(),
+        double_sided: meshio::DoubleSided::Keep,
+    };
+    meshio::write_gltf_with(packed, plain, &nothing).unwrap();
+    plain.to_owned()
+}
+
 /// The first `len` bytes of buffer view `view` of a GLB whose views all lie in its BIN chunk.
 fn decoded_view(path: &Path, view: usize, len: usize) -> Vec<u8> {
     let bytes = std::fs::read(path).unwrap();
@@ -327,17 +339,10 @@ fn the_khr_form_decodes_to_the_same_bytes_as_the_ext_form() {
             assert!(!colour_filtered);
         }
         // Written back decoded (no compression extension), then read byte for byte.
-        let plain = dir.path().join(format!("grid-{form}-decoded.glb"));
-        meshio::write_gltf_with(
+        let plain = write_decoded(
             &packed,
-            &plain,
-            &meshio::GltfBake {
-                colour: None,
-                attributes: Vec::new(),
-                double_sided: meshio::DoubleSided::Keep,
-            },
-        )
-        .unwrap();
+            &dir.path().join(format!("grid-{form}-decoded.glb")),
+        );
         let (attributes, views) = glb_contents(&plain);
         assert!(views.is_empty(), "{form}: still compressed: {views:?}");
         if let Some(reference) = test_data::meshopt_reference_decode(&packed) {
@@ -356,17 +361,10 @@ fn the_khr_form_decodes_to_the_same_bytes_as_the_ext_form() {
     for bits in ["6", "12"] {
         let packed = dir.path().join(format!("grid-khr-{bits}.glb"));
         pack(&input, &packed, &["-cc", "-ce", "khr", "-vc", bits]).unwrap();
-        let plain = dir.path().join(format!("grid-khr-{bits}-decoded.glb"));
-        meshio::write_gltf_with(
+        let plain = write_decoded(
             &packed,
-            &plain,
-            &meshio::GltfBake {
-                colour: None,
-                attributes: Vec::new(),
-                double_sided: meshio::DoubleSided::Keep,
-            },
-        )
-        .unwrap();
+            &dir.path().join(format!("grid-khr-{bits}-decoded.glb")),
+        );
         let reference = test_data::meshopt_reference_decode(&packed).unwrap();
         for (view, expected) in reference {
             assert!(

@@ -120,6 +120,35 @@ fn node_modules() -> PathBuf {
     )
 }
 
+/// Runs `js/SCRIPT` on `path` with node, the npm package `package` required in
+/// [`node_modules`]; `None` (after [`skip`]) when the package or node is missing.
+#[track_caller]
+fn run_node_script(
+    script: &str,
+    package: &str,
+    path: &std::path::Path,
+) -> Option<std::process::Output> {
+    let modules = node_modules();
+    if !modules.join(package).is_dir() {
+        return skip(&format!(
+            "the npm package {package} is not installed in {} (npm install --prefix target/gltf-validator {package})",
+            modules.display()
+        ));
+    }
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("js")
+        .join(script);
+    match std::process::Command::new("node")
+        .arg(&script)
+        .arg(path)
+        .env("NODE_PATH", &modules)
+        .output()
+    {
+        Ok(output) => Some(output),
+        Err(e) => skip(&format!("node cannot run ({e}); install Node.js")),
+    }
+}
+
 /// Runs the Khronos glTF validator (node + the npm package `gltf-validator`) on `path`.
 ///
 /// # Panics
@@ -128,23 +157,7 @@ fn node_modules() -> PathBuf {
 /// `None`.
 #[track_caller]
 pub fn validate_gltf(path: &std::path::Path) -> Option<GltfValidation> {
-    let modules = node_modules();
-    if !modules.join("gltf-validator").is_dir() {
-        return skip(&format!(
-            "the glTF validator is not installed in {} (npm install --prefix target/gltf-validator gltf-validator)",
-            modules.display()
-        ));
-    }
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("js/validate-gltf.cjs");
-    let output = match std::process::Command::new("node")
-        .arg(&script)
-        .arg(path)
-        .env("NODE_PATH", &modules)
-        .output()
-    {
-        Ok(output) => output,
-        Err(e) => return skip(&format!("node cannot run ({e}); install Node.js")),
-    };
+    let output = run_node_script("validate-gltf.cjs", "gltf-validator", path)?;
     let summary = String::from_utf8_lossy(&output.stdout).trim().to_owned();
     assert!(
         matches!(output.status.code(), Some(0 | 1)),
@@ -199,23 +212,7 @@ pub fn gltfpack(args: &[&std::ffi::OsStr]) -> Option<()> {
 /// fails on the file.
 #[track_caller]
 pub fn meshopt_reference_decode(path: &std::path::Path) -> Option<Vec<(usize, Vec<u8>)>> {
-    let modules = node_modules();
-    if !modules.join("meshoptimizer").is_dir() {
-        return skip(&format!(
-            "meshoptimizer's decoder is not installed in {} (npm install --prefix target/gltf-validator meshoptimizer)",
-            modules.display()
-        ));
-    }
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("js/meshopt-decode.cjs");
-    let output = match std::process::Command::new("node")
-        .arg(&script)
-        .arg(path)
-        .env("NODE_PATH", &modules)
-        .output()
-    {
-        Ok(output) => output,
-        Err(e) => return skip(&format!("node cannot run ({e}); install Node.js")),
-    };
+    let output = run_node_script("meshopt-decode.cjs", "meshoptimizer", path)?;
     assert!(
         output.status.success(),
         "meshoptimizer's decoder failed on {}: {}",
