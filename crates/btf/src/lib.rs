@@ -18,7 +18,10 @@
 //!   (eq. 5.5); and measures the error against the measurement ([`BtfPca::stats`]);
 //! * renders a mesh textured by the compressed BTF under a point or directional light
 //!   ([`render`]: per-vertex γ and ω, per-fragment texel sums blended over the triangle; a CPU
-//!   reference and a wgpu renderer behind the default feature `gpu`) — §5.5.
+//!   reference and a wgpu renderer behind the default feature `gpu`) — §5.5;
+//! * extracts the per-frame fin geometry of silhouette enhancement ([`fins`]: silhouette edges
+//!   chained into loops, extruded along the vertex normals, the corrected texture coordinates
+//!   of eqs. 5.16–5.21) — §5.7.3.
 //!
 //! γ is computed apart from the texel sum so that environment illumination (γ*, §5.5.2) can
 //! accumulate many light directions into it ([`BtfPca::accumulate_gamma`]). Background: the
@@ -67,6 +70,7 @@ pub mod compare;
 pub mod compress;
 pub mod dataset;
 mod error;
+pub mod fins;
 pub mod format;
 mod io;
 mod model;

@@ -408,3 +408,121 @@ fn a_fifo_named_like_an_image_is_refused_not_waited_on() {
         "{message}"
     );
 }
+
+#[path = "common/fin_meshes.rs"]
+mod fin_meshes;
+
+mod fins {
+    use super::fin_meshes::*;
+    use btf::fins::{FinBuilder, FinMesh, FinParams, Viewer};
+    use glam::Vec3;
+
+    fn build(mesh: &Mesh, viewer: Viewer) -> FinMesh {
+        let mut builder = FinBuilder::new(&mesh.triangles, mesh.positions.len()).unwrap();
+        let mut fins = FinMesh::default();
+        builder.build(
+            &mesh.positions,
+            &mesh.normals,
+            viewer,
+            &FinParams::default(),
+            &mut fins,
+        );
+        fins
+    }
+
+    /// An eye inside a closed cylinder, on its axis: every triangle faces away, no silhouette,
+    /// no fin. Looking down the axis from outside (orthographic), the sides are exactly edge-on
+    /// (back-facing by the rule): the outline is the near cap's rim, one loop of 24 fins.
+    #[test]
+    fn no_silhouette_from_inside_a_closed_cylinder_on_its_axis() {
+        let mesh = closed_cylinder(24);
+        let inside = build(&mesh, Viewer::Eye(Vec3::new(0.0, 0.0, 0.5)));
+        assert!(inside.is_empty(), "{} fins", inside.len());
+        assert_eq!(inside.chains(), 0);
+        let along = build(&mesh, Viewer::Direction(Vec3::Z));
+        assert_eq!((along.len(), along.chains()), (24, 1));
+        assert!(
+            along.ends.iter().flatten().all(|&v| (24..48).contains(&v)),
+            "near rim only"
+        );
+    }
+
+    /// The border of an open sheet is its silhouette from above and from below, run the other
+    /// way round from the other side.
+    #[test]
+    fn a_silhouette_through_a_border_edge() {
+        let mesh = sheet(4, 0.0);
+        let above = build(&mesh, Viewer::Direction(Vec3::Y));
+        let below = build(&mesh, Viewer::Direction(-Vec3::Y));
+        assert_eq!((above.len(), below.len()), (16, 16));
+        assert_eq!((above.chains(), below.chains()), (1, 1));
+        let mut reversed: Vec<[u32; 2]> = below.ends.iter().map(|&[a, b]| [b, a]).collect();
+        let mut forward = above.ends.clone();
+        reversed.sort_unstable();
+        forward.sort_unstable();
+        assert_eq!(forward, reversed);
+    }
+
+    /// Two triangles folded into a sharp ridge along x: seen from one side and from exactly
+    /// the opposite side, one triangle faces the viewer and the other does not, so the ridge
+    /// is a silhouette both times, oriented oppositely.
+    #[test]
+    fn a_crease_that_is_a_silhouette_for_two_opposite_views() {
+        let positions = vec![
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::new(0.5, -0.2, 1.0),
+            Vec3::new(0.5, 0.2, 1.0),
+        ];
+        let triangles = vec![[0, 1, 2], [1, 0, 3]];
+        let mut builder = FinBuilder::new(&triangles, 4).unwrap();
+        let view = Vec3::new(0.0, 1.0, 0.05).normalize();
+        let one = builder.silhouette_edges(&positions, Viewer::Direction(view));
+        let other = builder.silhouette_edges(&positions, Viewer::Direction(-view));
+        let ridge = |edges: &[[u32; 2]]| {
+            edges
+                .iter()
+                .copied()
+                .find(|e| e.contains(&0) && e.contains(&1))
+        };
+        let (a, b) = (ridge(&one).unwrap(), ridge(&other).unwrap());
+        assert_eq!(a, [b[1], b[0]], "opposite orientation");
+    }
+
+    /// A sphere of radius 10 moved by 1e5 on every axis (f32 positions 0.0078 apart there):
+    /// the silhouette equals the brute-force f64 test on the same positions, the fins are
+    /// finite and their height is kept to the positions' resolution.
+    #[test]
+    fn fins_on_a_mesh_offset_by_1e5() {
+        let offset = Vec3::splat(1e5);
+        let mesh = sphere(10.0, 12, 18).offset(offset);
+        let eye = offset + Vec3::new(30.0, 12.0, -20.0);
+        let mut builder = FinBuilder::new(&mesh.triangles, mesh.positions.len()).unwrap();
+        let found = builder.silhouette_edges(&mesh.positions, Viewer::Eye(eye));
+        let expected = brute_force_silhouette(&mesh, |p| eye.as_dvec3() - p);
+        assert_eq!(unordered(&found), expected);
+        let params = FinParams {
+            material_size: 1.0,
+            height: 0.5,
+            offset: 0.0,
+        };
+        let mut fins = FinMesh::default();
+        builder.build(
+            &mesh.positions,
+            &mesh.normals,
+            Viewer::Eye(eye),
+            &params,
+            &mut fins,
+        );
+        assert!(!fins.is_empty());
+        for f in 0..fins.len() {
+            let rise = fins.positions[4 * f + 2].distance(fins.positions[4 * f]);
+            assert!((rise - 0.5).abs() < 0.02, "fin {f} rises {rise}");
+            assert!(
+                fins.texcoords[4 * f..4 * f + 4]
+                    .iter()
+                    .all(|t| t.is_finite())
+            );
+        }
+    }
+}
