@@ -118,7 +118,7 @@ pub fn image_file_name(sampling: Sampling, view: usize, light: usize, ext: &str)
 }
 
 /// The four angles of a file name: (θl, φl, θv, φv) in degrees.
-type Angles = [u32; 4];
+pub(crate) type Angles = [u32; 4];
 
 /// Parses a UBO2003 file stem; `Err(reason)` when it does not match.
 fn parse_stem(stem: &str) -> std::result::Result<Angles, &'static str> {
@@ -154,9 +154,10 @@ pub struct BtfDir {
 }
 
 /// A parsed candidate file.
-struct Found {
-    path: PathBuf,
-    angles: Angles,
+pub(crate) struct Found {
+    pub path: PathBuf,
+    /// (θl, φl, θv, φv) in degrees.
+    pub angles: Angles,
 }
 
 impl BtfDir {
@@ -321,7 +322,7 @@ fn check_index(what: &'static str, index: usize) -> Result<()> {
     Ok(())
 }
 
-fn check_finite(values: &[f32], what: impl Fn() -> String) -> Result<()> {
+pub(crate) fn check_finite(values: &[f32], what: impl Fn() -> String) -> Result<()> {
     match values.iter().position(|v| !v.is_finite()) {
         Some(index) => Err(BtfError::NonFinite {
             what: what(),
@@ -333,7 +334,7 @@ fn check_finite(values: &[f32], what: impl Fn() -> String) -> Result<()> {
 }
 
 /// Lists the folder; parses every image name. Sorted by file name so errors are deterministic.
-fn scan(root: &Path) -> Result<Vec<Found>> {
+pub(crate) fn scan(root: &Path) -> Result<Vec<Found>> {
     let entries = std::fs::read_dir(root).map_err(|e| BtfError::io(root, "list", e))?;
     let mut found = Vec::new();
     for entry in entries {
@@ -416,7 +417,7 @@ fn decide_sampling(found: &[Found]) -> Result<Sampling> {
 }
 
 /// Reads every header (in parallel) and checks all sizes against the first file's.
-fn check_sizes(files: &[PathBuf]) -> Result<(usize, usize)> {
+pub(crate) fn check_sizes(files: &[PathBuf]) -> Result<(usize, usize)> {
     let sizes: Vec<Result<(usize, usize)>> = files.par_iter().map(|p| read_dimensions(p)).collect();
     let mut reference: Option<(usize, usize)> = None;
     for (path, size) in files.iter().zip(sizes) {

@@ -219,6 +219,36 @@ pub enum BtfError {
         /// What is wrong.
         reason: &'static str,
     },
+    /// A `.finpca` file (a compressed fin BTF, [`crate::fin_pca`]) is malformed.
+    #[error(
+        "{path}: invalid .finpca file: field `{field}` = {value}: {reason}; the file is \
+         truncated, corrupt or not a .finpca file — write it again with \
+         `cloth-vis btf fins compress`"
+    )]
+    FinFormat {
+        /// The file (`<bytes>` when reading from memory).
+        path: PathBuf,
+        /// The field.
+        field: &'static str,
+        /// Its value.
+        value: String,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// A fin BTF folder lacks light images or has an image of another view.
+    #[error(
+        "{dir}: {problem}; a fin BTF folder holds the 81 light directions of Table 5.3 \
+         (θ ∈ {{0, 15, 30, 45, 60, 75}}) at the one grazing view, named \
+         `tl{{θl:03}} pl{{φl:03}} tv090 pv000.png` (jpg, jpeg, exr), e.g. `{example}`"
+    )]
+    FinDir {
+        /// The folder (or the offending file).
+        dir: PathBuf,
+        /// What is wrong.
+        problem: String,
+        /// A name the folder should hold.
+        example: String,
+    },
     /// A GPU resource would exceed a limit of the device (`render::GpuBtfRenderer`).
     #[error("{what}: needs {value} but the device limit `{limit}` is {maximum}; {hint}")]
     GpuLimit {

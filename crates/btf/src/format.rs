@@ -41,15 +41,20 @@ pub const MAGIC: [u8; 8] = *b"\x89BTFPCA\n";
 /// The format version written and read.
 pub const VERSION: u16 = 1;
 const HEADER_LEN: usize = 40;
-const SLOT_TABLE_LEN: usize = DIRECTIONS * 8;
 const CRC_LEN: usize = 4;
 
 impl BtfPca {
     /// Serialises to the `.btfpca` layout of [`crate::format`](mod@crate::format).
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut out =
-            Vec::with_capacity(HEADER_LEN + SLOT_TABLE_LEN + self.payload_bytes() + CRC_LEN);
-        out.extend_from_slice(&MAGIC);
+        self.to_bytes_with(&MAGIC)
+    }
+
+    /// The layout with another signature (the fin file, [`crate::fin_pca`], shares it with
+    /// one slot).
+    pub(crate) fn to_bytes_with(&self, magic: &[u8; 8]) -> Vec<u8> {
+        let table_len = self.slots.len() * 8;
+        let mut out = Vec::with_capacity(HEADER_LEN + table_len + self.payload_bytes() + CRC_LEN);
+        out.extend_from_slice(magic);
         out.extend_from_slice(&VERSION.to_le_bytes());
         out.push(match self.sampling {
             Sampling::H1 => 1,
@@ -66,7 +71,7 @@ impl BtfPca {
         ] {
             out.extend_from_slice(&(v as u32).to_le_bytes());
         }
-        let total = HEADER_LEN + SLOT_TABLE_LEN + self.payload_bytes() + CRC_LEN;
+        let total = HEADER_LEN + table_len + self.payload_bytes() + CRC_LEN;
         out.extend_from_slice(&(total as u64).to_le_bytes());
         for s in &self.slots {
             out.extend_from_slice(&(s.components() as u32).to_le_bytes());
@@ -104,7 +109,7 @@ impl BtfPca {
     /// # Errors
     /// [`BtfError::Format`] naming the first invalid field; never panics on any input.
     pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
-        parse(bytes, Path::new("<bytes>"))
+        parse(bytes, Path::new("<bytes>"), &BTFPCA)
     }
 
     /// Writes a `.btfpca` file atomically (temporary file + rename).
@@ -123,9 +128,27 @@ impl BtfPca {
     /// first invalid field.
     pub fn read(path: &Path) -> Result<Self> {
         let bytes = input_guard::read_regular(path).map_err(|e| BtfError::io(path, "read", e))?;
-        parse(&bytes, path)
+        parse(&bytes, path, &BTFPCA)
     }
 }
+
+/// What distinguishes the files sharing this layout: signature, name and slot count.
+pub(crate) struct Kind {
+    pub magic: [u8; 8],
+    /// For messages: "a .btfpca file".
+    pub name: &'static str,
+    pub slots: usize,
+    /// For messages: "must be 81".
+    pub slots_reason: &'static str,
+}
+
+/// The per-view BTF file.
+const BTFPCA: Kind = Kind {
+    magic: MAGIC,
+    name: "not a .btfpca file",
+    slots: DIRECTIONS,
+    slots_reason: "must be 81",
+};
 
 /// A cursor over validated bytes.
 struct Reader<'a> {
@@ -194,14 +217,14 @@ fn bad(
     }
 }
 
-fn parse(bytes: &[u8], path: &Path) -> Result<BtfPca> {
-    let fixed = HEADER_LEN + SLOT_TABLE_LEN + CRC_LEN;
+pub(crate) fn parse(bytes: &[u8], path: &Path, kind: &Kind) -> Result<BtfPca> {
+    let fixed = HEADER_LEN + kind.slots * 8 + CRC_LEN;
     if bytes.len() < fixed {
         return Err(bad(
             path,
             "length",
-            bytes.len(),
-            "shorter than the fixed header (692 bytes)",
+            format!("{} (the fixed header has {fixed})", bytes.len()),
+            "shorter than the fixed header",
         ));
     }
     let mut r = Reader {
@@ -210,8 +233,8 @@ fn parse(bytes: &[u8], path: &Path) -> Result<BtfPca> {
         path,
     };
     let magic = r.take(8, "magic")?;
-    if magic != MAGIC {
-        return Err(r.bad("magic", format!("{magic:02x?}"), "not a .btfpca file"));
+    if magic != kind.magic {
+        return Err(r.bad("magic", format!("{magic:02x?}"), kind.name));
     }
     let vb = r.take(2, "version")?;
     let version = u16::from_le_bytes([vb[0], vb[1]]);
@@ -247,8 +270,8 @@ fn parse(bytes: &[u8], path: &Path) -> Result<BtfPca> {
             "must be ≥ 1",
         ));
     }
-    if slot_count != DIRECTIONS {
-        return Err(r.bad("slot count", slot_count, "must be 81"));
+    if slot_count != kind.slots {
+        return Err(r.bad("slot count", slot_count, kind.slots_reason));
     }
     let lb = r.take(8, "file length")?;
     let declared = u64::from_le_bytes(lb.try_into().unwrap_or([0; 8]));
@@ -259,8 +282,8 @@ fn parse(bytes: &[u8], path: &Path) -> Result<BtfPca> {
             "the declared length differs from the actual one (truncated or extended file)",
         ));
     }
-    let mut table = Vec::with_capacity(DIRECTIONS);
-    for _ in 0..DIRECTIONS {
+    let mut table = Vec::with_capacity(kind.slots);
+    for _ in 0..kind.slots {
         let c = r.u32("slot components")? as usize;
         let rank = r.u32("slot rank")? as usize;
         if rank > MAX_COMPONENTS || c > rank || c > requested {
@@ -317,7 +340,7 @@ fn parse(bytes: &[u8], path: &Path) -> Result<BtfPca> {
     }
     // From here every size is bounded by the bytes present.
     let values = values as usize;
-    let mut slots = Vec::with_capacity(DIRECTIONS);
+    let mut slots = Vec::with_capacity(kind.slots);
     for &(c, rank) in &table {
         let mut ranges = Vec::with_capacity(c + 1);
         for _ in 0..=c {

@@ -21,7 +21,9 @@
 //!   reference and a wgpu renderer behind the default feature `gpu`) — §5.5;
 //! * extracts the per-frame fin geometry of silhouette enhancement ([`fins`]: silhouette edges
 //!   chained into loops, extruded along the vertex normals, the corrected texture coordinates
-//!   of eqs. 5.16–5.21) — §5.7.3.
+//!   of eqs. 5.16–5.21) — §5.7.3; and the fin BTF drawn on them ([`fin_pca`]: 81 grazing-view
+//!   images under Table 5.3's lights, their PCA of eq. 5.14 in a validated `.finpca` file, the
+//!   alpha of Listing 5.1) — §5.7.2.
 //!
 //! γ is computed apart from the texel sum so that environment illumination (γ*, §5.5.2) can
 //! accumulate many light directions into it ([`BtfPca::accumulate_gamma`]). Background: the
@@ -70,6 +72,7 @@ pub mod compare;
 pub mod compress;
 pub mod dataset;
 mod error;
+pub mod fin_pca;
 pub mod fins;
 pub mod format;
 mod io;

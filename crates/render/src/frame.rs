@@ -28,6 +28,9 @@ pub enum Phase {
     Opaque,
     /// Reads the depth (and stencil) the opaque passes left: shadow volumes, translucency.
     DepthReading,
+    /// Blends over everything else, the backdrop included, testing depth without writing it:
+    /// BTF fins (thesis §5.7.3), whose passes must be order-independent among themselves.
+    Blended,
 }
 
 /// What an effect implements to join the frame.
@@ -146,7 +149,7 @@ impl Renderer {
     /// Order: clear (colour to the background's colour with alpha 0, depth to the far value,
     /// stencil to 0) → Gouraud meshes → `passes` of [`Phase::Opaque`] → `passes` of
     /// [`Phase::DepthReading`] → the backdrop (only with [`Background::Environment`]) →
-    /// MSAA resolve → read-back. The tone map is the caller's choice: on the read-back image
+    /// `passes` of [`Phase::Blended`] → MSAA resolve → read-back. The tone map is the caller's choice: on the read-back image
     /// ([`crate::output`], so the EXR keeps linear radiance and automatic exposure can read
     /// the objects' pixels), or on the GPU with [`Renderer::render_display`]. Alpha is the
     /// objects' coverage (a fraction of the samples at edges); background pixels have alpha 0.
@@ -309,6 +312,10 @@ impl Renderer {
             }
             if background == Background::Environment {
                 self.backdrop.record(&mut pass);
+            }
+            for p in passes.iter().filter(|p| p.phase() == Phase::Blended) {
+                p.record(&mut pass);
+                pass.set_bind_group(0, &self.view_group, &[]);
             }
         }
         queue.submit([encoder.finish()]);

@@ -19,8 +19,9 @@
 //! | 2 | other opaque passes ([`Phase::Opaque`]): BTF materials | test + write | — | effects |
 //! | 3 | passes reading depth/stencil ([`Phase::DepthReading`]): shadow volumes, translucency | test | read/write | effects |
 //! | 4 | environment backdrop, only where depth is still the far value | equal | — | [`BackdropPass`] |
-//! | 5 | MSAA resolve | | | [`Renderer`] |
-//! | 6 | tone map: exposure (EV), tone curve, sRGB, un-premultiplied colour + alpha | | | [`ToneMapPass`] on the GPU ([`Renderer::render_display`], a viewer's surface), or [`output`] + [`tone`] on the read-back HDR image (PNG; linear EXR) |
+//! | 5 | blended passes ([`Phase::Blended`]): BTF fins, premultiplied colour over everything | test | — | effects |
+//! | 6 | MSAA resolve | | | [`Renderer`] |
+//! | 7 | tone map: exposure (EV), tone curve, sRGB, un-premultiplied colour + alpha | | | [`ToneMapPass`] on the GPU ([`Renderer::render_display`], a viewer's surface), or [`output`] + [`tone`] on the read-back HDR image (PNG; linear EXR) |
 //!
 //! The two tone maps agree within one 8-bit code (tested). Files go through the CPU one so
 //! the EXR keeps linear radiance and automatic exposure can read the objects' pixels and

@@ -92,6 +92,23 @@ impl FrameFormat {
         }
     }
 
+    /// Depth-stencil state of blended geometry: test against the opaque depth, write nothing.
+    pub fn blended_depth(&self) -> wgpu::DepthStencilState {
+        wgpu::DepthStencilState {
+            depth_write_enabled: Some(false),
+            ..self.opaque_depth()
+        }
+    }
+
+    /// Colour target state with `blend`.
+    pub fn blended_color_target(&self, blend: wgpu::BlendState) -> wgpu::ColorTargetState {
+        wgpu::ColorTargetState {
+            format: self.color,
+            blend: Some(blend),
+            write_mask: wgpu::ColorWrites::ALL,
+        }
+    }
+
     /// Colour target state without blending.
     pub fn color_target(&self) -> wgpu::ColorTargetState {
         wgpu::ColorTargetState {

@@ -196,7 +196,7 @@ fn texel_bytes(texture: &Texture, storage: Storage, out: &mut Vec<u8>) {
 }
 
 /// Fails with [`BtfError::GpuLimit`] when a storage buffer of `bytes` exceeds the device.
-fn check_buffer(device: &wgpu::Device, what: &'static str, bytes: u64) -> Result<()> {
+pub(super) fn check_buffer(device: &wgpu::Device, what: &'static str, bytes: u64) -> Result<()> {
     let limits = device.limits();
     let (limit, maximum) = if limits.max_storage_buffer_binding_size <= limits.max_buffer_size {
         (
@@ -221,7 +221,7 @@ fn check_buffer(device: &wgpu::Device, what: &'static str, bytes: u64) -> Result
     Ok(())
 }
 
-fn storage_init(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+pub(super) fn storage_init(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
     // A binding may not be empty; 16 zero bytes keep an empty mesh valid.
     let contents: &[u8] = if bytes.is_empty() { &[0; 16] } else { bytes };
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -231,7 +231,7 @@ fn storage_init(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffe
     })
 }
 
-fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+pub(super) fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry {
         binding,
         resource: b.as_entire_binding(),

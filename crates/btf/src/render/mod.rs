@@ -2,6 +2,11 @@
 //! (thesis §5.5, eqs. 5.2–5.5), on the CPU ([`render_cpu`]) and with wgpu
 //! ([`GpuBtfRenderer`], feature `gpu`), headless, into a [`RenderedImage`].
 //!
+//! Fins (§5.7.3) are lit here too: [`fin_gammas`] takes γ at both ends of every fin of a
+//! [`FinMesh`](crate::fins::FinMesh), [`fin_fragment`] is the CPU reference of Listing 5.1,
+//! and [`GpuFinRenderer`] draws them into the shared frame in two order-independent passes
+//! (see its module for why they differ from Fig. 5.22 as printed).
+//!
 //! # What the thesis does, and what is computed where
 //!
 //! §5.5 reconstructs "the texture T for a vertex V of a given triangle mesh": **per vertex**,
@@ -91,6 +96,9 @@
 //! ```
 
 mod cpu;
+mod fin_shade;
+#[cfg(feature = "gpu")]
+mod fins_gpu;
 #[cfg(feature = "gpu")]
 mod gpu;
 mod image;
@@ -99,6 +107,9 @@ mod shade;
 mod tangent;
 
 pub use cpu::render_cpu;
+pub use fin_shade::{FinShading, fin_fragment, fin_gammas};
+#[cfg(feature = "gpu")]
+pub use fins_gpu::{FinDraw, GpuFinRenderer};
 #[cfg(feature = "gpu")]
 pub use gpu::{BtfDraw, GpuBtfRenderer};
 pub use image::RenderedImage;
