@@ -1,5 +1,5 @@
-//! Procedural data for demos and tests: a cloth drape animation, HDR skies with a sun, and
-//! a woven-cloth BTF.
+//! Procedural data for demos and tests: a cloth drape animation, HDR skies with a sun, a
+//! woven-cloth BTF and wool fin images.
 //!
 //! Nothing here reads a file; everything is deterministic for its parameters (including
 //! the seed). Output is plain data (glam vectors, `Vec`s), not other project crates' types.
@@ -25,11 +25,19 @@
 //!   what a BTF adds to a texture — parallax and masking under oblique views, yarns
 //!   shadowing each other under grazing light. [`WovenBtf::view`] traces one view,
 //!   [`ViewHits::shade`] lights it; 81 × 81 images of 64² take a few seconds.
+//! * [`WoolFins`] ([`fins`]): a procedural wool fin BTF, the stand-in for the grazing-view
+//!   images of fuzzy cloth used for silhouette enhancement (thesis §5.7.2 "BTF fins",
+//!   Tab. 5.3): a periodic layer of curved, tapering strands seen from the fixed view
+//!   θ_V = 90° against black, lit from any direction with Kajiya–Kay diffuse reflection, a
+//!   forward-scattering lobe and self-shadowing through the fibre cloud. Each
+//!   [`FinImage`] is premultiplied RGB with the fibre coverage as alpha, falling off at the
+//!   tips.
 //!
 //! No seed section specifies this crate, so no seed equation is implemented here; the
 //! methods are cited in each module (Macklin et al. 2016/2019 for XPBD, Bergou et al. 2006
 //! for bending, Kim et al. 2012 for tethers, Preetham et al. 1999 for the sky, the thesis's
-//! §5.3 acquisition set-up for the BTF's sampling and registration).
+//! §5.3 acquisition set-up for the BTF's sampling and registration, Kajiya & Kay 1989 and
+//! the §5.7.2 set-up for the fins).
 //!
 //! # Examples
 //! ```
@@ -55,6 +63,7 @@
 pub mod btf;
 mod cloth;
 mod error;
+pub mod fins;
 pub mod latlong;
 mod rng;
 mod sky;
@@ -69,5 +78,10 @@ pub use cloth::{
     simulate_cloth_with_progress,
 };
 pub use error::{Result, SynthError};
+pub use fins::{
+    FIN_VIEW_DIR, FinImage, MAX_FIN_SAMPLES, MAX_FIN_SEGMENTS, MAX_FIN_SIDE, MAX_FIN_SUPERSAMPLE,
+    MAX_STRAND_COORD, MAX_STRAND_ROOT_RADIUS, MAX_STRAND_SEGMENTS, WoolFinParams, WoolFins,
+    WoolStrand,
+};
 pub use latlong::LatLongImage;
 pub use sky::{MAX_TEXELS, SkyParams, sky, sun_direction, sun_radiance};
