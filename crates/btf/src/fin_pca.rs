@@ -375,6 +375,15 @@ impl FinPca {
         self.pca.image(0, light)
     }
 
+    /// The reconstruction error against the images it was compressed from (8-bit sRGB units,
+    /// PSNR), over all 81.
+    ///
+    /// # Errors
+    /// [`BtfError::LengthMismatch`] for images of another size.
+    pub fn stats(&self, images: &ViewSlot) -> Result<crate::ErrorStats> {
+        self.pca.stats_slot(images)
+    }
+
     /// Serialises to the `.finpca` layout (the `.btfpca` layout with one slot).
     pub fn to_bytes(&self) -> Vec<u8> {
         self.pca.to_bytes_with(&FIN_MAGIC)

@@ -171,6 +171,86 @@ pub fn render_objects(
     Ok(HdrImage::new(camera.width, camera.height, pixels)?)
 }
 
+/// What fins cost in a frame of [`render_with_fins`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FinCost {
+    /// Fins drawn.
+    pub fins: usize,
+    /// Milliseconds of silhouette extraction and fin building on the CPU.
+    pub extract_ms: f64,
+    /// Milliseconds of fin lighting (γ per end) and upload.
+    pub prepare_ms: f64,
+    /// Median milliseconds of the frame with fins (draw and read-back; 3 runs).
+    pub frame_ms: f64,
+    /// Median milliseconds of the same frame without fins (3 runs).
+    pub frame_without_ms: f64,
+}
+
+/// Renders `objects` with `pca` on the GPU as [`render_objects`] does, then again with the
+/// fins of `fins` on every object (thesis §5.7): the image without fins, the image with them,
+/// and what the fins cost.
+///
+/// # Errors
+/// As [`render_objects`]; fin extraction and GPU-limit errors.
+#[allow(clippy::too_many_arguments)] // one frame's inputs; a struct would only rename them
+pub fn render_with_fins(
+    g: &GpuContext,
+    pca: &BtfPca,
+    objects: &[&WorldObject],
+    light: &Light,
+    camera: &Camera,
+    params: &RenderParams,
+    fins: &btf::fin_pca::FinPca,
+    look: &crate::fins_stage::FinLook,
+) -> Result<(HdrImage, HdrImage, FinCost), Error> {
+    let frames = objects
+        .iter()
+        .map(|o| tangents_of(o))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut renderer = Renderer::new(&g.device, FrameFormat::single_sample(&g.device));
+    let btf = GpuBtfRenderer::for_frame(&g.device, &g.queue, pca, &renderer.pass_context())?;
+    let fin_renderer = crate::fins_stage::fin_renderer(&g.device, fins, &renderer.pass_context())?;
+    let draws = objects
+        .iter()
+        .zip(&frames)
+        .map(|(o, (t, uv))| btf.prepare(&btf_mesh(o, t, uv), light, camera, params))
+        .collect::<Result<Vec<_>, _>>()?;
+    let fin_frame = crate::fins_stage::fin_frame(&fin_renderer, objects, light, camera, look)?;
+    let background = Background::Color(params.background.to_array());
+    let mut run = |with_fins: bool| -> Result<(HdrImage, f64), Error> {
+        let mut passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
+        if with_fins {
+            passes.extend(fin_frame.draws.iter().map(|d| d as &dyn FramePass));
+        }
+        let mut times = Vec::with_capacity(3);
+        let mut last = None;
+        for _ in 0..3 {
+            let start = Instant::now();
+            last = Some(renderer.render(&g.device, &g.queue, camera, background, &passes)?);
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        times.sort_by(f64::total_cmp);
+        let image = last.ok_or_else(|| Error::Request {
+            path: PathBuf::from("btf.fins"),
+            message: "no frame was rendered".to_owned(),
+        })?;
+        Ok((image, times[1]))
+    };
+    let (without, frame_without_ms) = run(false)?;
+    let (with, frame_ms) = run(true)?;
+    Ok((
+        without,
+        with,
+        FinCost {
+            fins: fin_frame.fins,
+            extract_ms: fin_frame.extract_ms,
+            prepare_ms: fin_frame.prepare_ms,
+            frame_ms,
+            frame_without_ms,
+        },
+    ))
+}
+
 /// The seed's display of a BTF render: linear radiance clamped to [0, 1], then sRGB-encoded
 /// (the normtextures are sRGB images, so a unit light shows them as measured); opaque.
 fn display() -> render::tone::Display {
@@ -211,6 +291,7 @@ fn scene_frame(
     light: &Light,
     look: &Look,
     params: &RenderParams,
+    fins: Option<&crate::fins_stage::FinFrame>,
 ) -> Result<HdrImage, Error> {
     let btf = GpuBtfRenderer::for_frame(&gpu.device, &gpu.queue, pca, &renderer.pass_context())?;
     let draws = chosen
@@ -218,7 +299,10 @@ fn scene_frame(
         .zip(frames)
         .map(|(o, (t, uv))| btf.prepare(&btf_mesh(o, t, uv), light, &look.camera, params))
         .collect::<Result<Vec<_>, _>>()?;
-    let passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
+    let mut passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
+    if let Some(f) = fins {
+        passes.extend(f.draws.iter().map(|d| d as &dyn FramePass));
+    }
     Ok(renderer.render(
         &gpu.device,
         &gpu.queue,
@@ -280,10 +364,42 @@ pub(crate) fn run(
     };
     let mut params = RenderParams::default();
     params.uv_scale = Vec2::splat(desc.uv_scale);
+    let fins = match &desc.fins {
+        Some(f) => {
+            let source = match f.source.as_str() {
+                crate::fins_stage::SYNTH_WOOL => crate::fins_stage::FinSource::SynthWool,
+                file => crate::fins_stage::FinSource::File(scene.base_dir.join(file)),
+            };
+            let fin_pca = source.load(btf::DEFAULT_COMPONENTS)?;
+            let (_, radius) = render::bounding_sphere(chosen.iter().flat_map(|o| &o.positions))
+                .unwrap_or((Vec3::ZERO, 1.0));
+            let look_fins = crate::fins_stage::FinLook::for_radius(radius, f.height, f.size);
+            let fin_renderer =
+                crate::fins_stage::fin_renderer(&gpu.device, &fin_pca, &renderer.pass_context())?;
+            Some(crate::fins_stage::fin_frame(
+                &fin_renderer,
+                &chosen,
+                &light,
+                &look.camera,
+                &look_fins,
+            )?)
+        }
+        None => None,
+    };
     let render_start = Instant::now();
-    let with_btf = scene_frame(gpu, renderer, &pca, &chosen, &frames, &light, look, &params)?;
+    let with_btf = scene_frame(
+        gpu,
+        renderer,
+        &pca,
+        &chosen,
+        &frames,
+        &light,
+        look,
+        &params,
+        fins.as_ref(),
+    )?;
     let with_plain = scene_frame(
-        gpu, renderer, &plain, &chosen, &frames, &light, look, &params,
+        gpu, renderer, &plain, &chosen, &frames, &light, look, &params, None,
     )?;
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     let display = crate::run::display_for(scene, &with_btf);
@@ -308,7 +424,13 @@ pub(crate) fn run(
         "material_ms": material_ms,
         "render_ms": render_ms,
         "exposure_ev": display.exposure_ev,
-        "image": "left: BTF (§5.5), right: plain texture mapping (frontal normtexture); other objects Gouraud, one depth buffer",
+        "fins": fins.as_ref().map(|f| json!({
+            "source": desc.fins.as_ref().map(|d| d.source.clone()),
+            "fins": f.fins,
+            "extract_ms": f.extract_ms,
+            "prepare_ms": f.prepare_ms,
+        })),
+        "image": "left: BTF (§5.5, with fins §5.7 when asked), right: plain texture mapping (frontal normtexture); other objects Gouraud, one depth buffer",
     });
     Ok((vec![path], params))
 }

@@ -44,6 +44,7 @@ pub mod deform;
 pub mod demo;
 pub mod effects;
 mod error;
+pub mod fins_stage;
 mod frame_effects;
 mod image_checks;
 pub mod inputs;

@@ -131,6 +131,58 @@ fn demo_writes_non_constant_png_exr_and_a_report_of_the_planned_stages() {
 }
 
 #[test]
+fn fins_from_the_scene_fringe_the_btf_half_only() {
+    if !gpu_available() {
+        return;
+    }
+    let run = |fins: bool| {
+        let dir = tempfile::tempdir().unwrap();
+        let mut scene = small_demo();
+        scene.objects.retain(|o| o.name == "cloth");
+        scene.ground = None;
+        scene.output.background = cloth_vis::scene::BackgroundDesc::BLACK;
+        scene.effects = vec!["btf".to_owned()];
+        // One exposure for both runs: fins add light to the pixels automatic exposure reads.
+        scene.output.exposure = cloth_vis::scene::ExposureDesc::Fixed(0.0);
+        if fins {
+            scene.btf.fins = Some(cloth_vis::scene::FinsDesc {
+                source: "synth:wool".to_owned(),
+                height: None,
+                size: None,
+            });
+        }
+        run_scene(&scene, dir.path(), &RunOptions::default()).unwrap();
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("run-report.json")).unwrap())
+                .unwrap();
+        let btf_stage = json["stages"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["stage"] == "btf")
+            .unwrap()
+            .clone();
+        let png = image::open(dir.path().join("btf.png")).unwrap().to_rgb8();
+        (png, btf_stage)
+    };
+    let (plain, _) = run(false);
+    let (fringed, stage) = run(true);
+    assert!(
+        stage["params"]["fins"]["fins"].as_u64().unwrap() > 10,
+        "{stage}"
+    );
+    let (w, h) = (160, 128);
+    let changed = |x0: u32| {
+        (0..h)
+            .flat_map(|y| (x0..x0 + w).map(move |x| (x, y)))
+            .filter(|&(x, y)| plain.get_pixel(x, y) != fringed.get_pixel(x, y))
+            .count()
+    };
+    assert!(changed(0) > 50, "fins changed only {} pixels", changed(0));
+    assert_eq!(changed(w), 0, "the plain-texture half carries no fins");
+}
+
+#[test]
 fn a_run_without_lighting_reports_no_lighting_stage() {
     if !gpu_available() {
         return;

@@ -70,6 +70,16 @@ fn bad_btf_tables_are_named_before_any_work() {
         ("light_dir = [0.0, 0.0, 0.0]", "btf.light_dir"),
         ("uv_scale = -1.0", "btf.uv_scale"),
         ("png = \"../escape.png\"", "btf.png"),
+        ("fins = { source = \"missing.finpca\" }", "btf.fins.source"),
+        (
+            "fins = { source = \"synth:wool\", height = 0.0 }",
+            "btf.fins.height",
+        ),
+        (
+            "fins = { source = \"synth:wool\", size = nan }",
+            "btf.fins.size",
+        ),
+        ("fins = { source = \"synth:wool\", colour = 1 }", "colour"),
     ] {
         let text = format!("effects = [\"btf\"]\n{CLOTH}\n[btf]\n{table}\n");
         let err = Plan::for_scene(&scene(&text, dir.path()))

@@ -14,7 +14,6 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use btf::{BtfDir, BtfPca, BtfPcaParams, ErrorStats, Sampling};
-use glam::Vec3;
 
 use super::invalid as request;
 use cloth_vis::Error;
@@ -159,7 +158,7 @@ fn raw_bytes(w: usize, h: usize) -> u64 {
     (btf::DIRECTIONS * btf::DIRECTIONS * 3 * w * h) as u64
 }
 
-fn dir_bytes(dir: &Path) -> u64 {
+pub(super) fn dir_bytes(dir: &Path) -> u64 {
     std::fs::read_dir(dir)
         .map(|entries| {
             entries
@@ -298,223 +297,6 @@ pub fn run_stats(dir: &Path, file: &Path, progress: bool) -> Result<StatsSummary
     })
 }
 
-/// The light of `btf render`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum RenderLight {
-    /// A directional light: world-space direction towards the light.
-    Direction(Vec3),
-    /// A point light at this world-space position (no distance falloff, eq. 5.4).
-    Position(Vec3),
-}
-
-/// What `cloth-vis btf render` was asked to do.
-#[derive(Clone, Debug)]
-pub struct RenderRequest {
-    /// A mesh file with per-vertex UVs (.obj, .ply, .gltf, .glb) or `synth:cloth` (the last
-    /// frame of the synthetic drape).
-    pub mesh: PathBuf,
-    /// The `.btfpca` material.
-    pub btf: PathBuf,
-    /// The light.
-    pub light: RenderLight,
-    /// Linear RGB radiance g of the light.
-    pub radiance: Vec3,
-    /// Direction from the mesh towards the camera (the camera frames the mesh), in a Y-up frame
-    /// turned onto `up_axis` with the camera's up.
-    pub camera_direction: Vec3,
-    /// The mesh's up axis (z for Blender/CAD exports such as the Berkeley garments); lights
-    /// stay in the mesh's own coordinates.
-    pub up_axis: super::up_axis::UpAxis,
-    /// Image size in pixels.
-    pub size: [u32; 2],
-    /// Texture repeats across the mesh's UV range.
-    pub uv_scale: f32,
-    /// Draw plain texture mapping of the same material beside it (the thesis's Fig. 5.16).
-    pub beside_plain: bool,
-    /// Use the CPU reference renderer instead of the GPU.
-    pub cpu: bool,
-    /// The PNG to write.
-    pub out: PathBuf,
-}
-
-/// What `render` did.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RenderSummary {
-    /// Vertices and triangles drawn.
-    pub mesh: (usize, usize),
-    /// Image size written.
-    pub size: [u32; 2],
-    /// `gpu` or `cpu`.
-    pub backend: &'static str,
-    /// Wall-clock seconds of rendering (not loading).
-    pub seconds: f64,
-}
-
-impl RenderSummary {
-    /// One line for the terminal.
-    pub fn line(&self) -> String {
-        format!(
-            "btf render: {} vertices, {} triangles -> {}x{} ({}) in {:.2} s",
-            self.mesh.0, self.mesh.1, self.size[0], self.size[1], self.backend, self.seconds
-        )
-    }
-}
-
-/// The mesh of `btf render` as a world object with UVs.
-fn render_mesh(path: &Path) -> Result<cloth_vis::object::WorldObject, Error> {
-    let (positions, triangles, uvs, normals) = if path == Path::new("synth:cloth") {
-        let anim = synth::simulate_cloth(&synth::ClothParams::default())?;
-        let last = anim.frames.len() - 1;
-        let normals = meshio::compute_normals(
-            &anim.frames[last],
-            &anim.triangles,
-            meshio::NormalWeighting::Angle,
-        );
-        (
-            anim.frames[last].clone(),
-            anim.triangles,
-            Some(anim.uvs),
-            normals,
-        )
-    } else {
-        // UV seams (sewing-pattern garments) split into vertex copies; the normals stay those
-        // of the welded mesh, so the seams do not show in the shading.
-        let options = meshio::LoadOptions {
-            recompute_normals: true,
-            ..meshio::LoadOptions::default()
-        };
-        let (split, _) = meshio::load_mesh_split_seams(path, &options)?;
-        let mesh = split.mesh;
-        (mesh.positions, mesh.triangles, mesh.uvs, mesh.normals)
-    };
-    if uvs.is_none() {
-        return Err(request(
-            path,
-            "has no texture coordinates (no vt/TEXCOORD_0), and a BTF is looked up by them"
-                .to_owned(),
-        ));
-    }
-    Ok(cloth_vis::object::WorldObject {
-        name: path.display().to_string(),
-        positions,
-        normals,
-        triangles,
-        uvs,
-        albedo: Vec3::ONE,
-        two_sided: true,
-        front: None,
-        back: None,
-        animation: None,
-    })
-}
-
-/// Runs `btf render`: the mesh textured by the compressed BTF under one light (thesis §5.5),
-/// on the GPU (`gpu`) or the CPU reference (`request.cpu`).
-///
-/// # Errors
-/// An output that is not `.png` or a size of 0 (refused before loading); a mesh without UVs;
-/// a missing GPU without `--cpu`; file, tangent and rendering errors. Nothing is written on
-/// error.
-pub fn run_render(
-    request_: &RenderRequest,
-    gpu: Option<&gpu_context::GpuContext>,
-) -> Result<RenderSummary, Error> {
-    let png = request_
-        .out
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if !png {
-        return Err(request(
-            &request_.out,
-            "the image is written as .png".to_owned(),
-        ));
-    }
-    let [w, h] = request_.size;
-    if !(1..=cloth_vis::scene::MAX_IMAGE_SIDE).contains(&w)
-        || !(1..=cloth_vis::scene::MAX_IMAGE_SIDE).contains(&h)
-    {
-        return Err(request(
-            &request_.out,
-            format!(
-                "--size {w}x{h}: each side must be 1..={}",
-                cloth_vis::scene::MAX_IMAGE_SIDE
-            ),
-        ));
-    }
-    if !(request_.uv_scale.is_finite() && request_.uv_scale > 0.0) {
-        return Err(request(
-            &request_.out,
-            format!("--uv-scale {}: must be finite and > 0", request_.uv_scale),
-        ));
-    }
-    let gpu = match (request_.cpu, gpu) {
-        (true, _) => None,
-        (false, Some(g)) => Some(g),
-        (false, None) => {
-            return Err(request(
-                &request_.out,
-                "no GPU adapter was found (install Mesa's lavapipe: apt-get install \
-                 mesa-vulkan-drivers), or pass --cpu for the CPU reference renderer"
-                    .to_owned(),
-            ));
-        }
-    };
-    let pca = BtfPca::read(&request_.btf)?;
-    let object = render_mesh(&request_.mesh)?;
-    let (centre, radius) =
-        render::bounding_sphere(object.positions.iter()).unwrap_or((Vec3::ZERO, 1.0));
-    let up = super::up_axis::up_axis_rotation(request_.up_axis).as_quat();
-    let desc = cloth_vis::scene::CameraDesc {
-        width: w,
-        height: h,
-        direction: (up * request_.camera_direction).to_array(),
-        up: (up * Vec3::Y).to_array(),
-        ..cloth_vis::scene::CameraDesc::default()
-    };
-    let framed = cloth_vis::camera::resolve(&desc, centre, radius);
-    let camera = render::Camera::look_at(
-        framed.eye,
-        framed.target,
-        Vec3::from(desc.up),
-        desc.fov_deg,
-        w,
-        h,
-    );
-    let light = match request_.light {
-        RenderLight::Direction(d) => btf::render::Light::Directional {
-            dir_to_light_world: d,
-            radiance: request_.radiance,
-        },
-        RenderLight::Position(p) => btf::render::Light::Point {
-            position_world: p,
-            radiance: request_.radiance,
-        },
-    };
-    let mut params = btf::render::RenderParams::default();
-    params.uv_scale = glam::Vec2::splat(request_.uv_scale);
-    let start = Instant::now();
-    let objects = [&object];
-    let image =
-        cloth_vis::btf_stage::render_objects(gpu, &pca, &objects, &light, &camera, &params)?;
-    let picture = if request_.beside_plain {
-        let plain = cloth_vis::btf_stage::plain_material(&pca)?;
-        let flat =
-            cloth_vis::btf_stage::render_objects(gpu, &plain, &objects, &light, &camera, &params)?;
-        cloth_vis::btf_stage::side_by_side(&image, &flat)
-    } else {
-        cloth_vis::btf_stage::single(&image)
-    };
-    let seconds = start.elapsed().as_secs_f64();
-    figures::strip::write_png(&request_.out, &picture)?;
-    Ok(RenderSummary {
-        mesh: (object.positions.len(), object.triangles.len()),
-        size: [picture.width(), picture.height()],
-        backend: if gpu.is_some() { "gpu" } else { "cpu" },
-        seconds,
-    })
-}
-
 /// The `btf` subcommands.
 #[derive(clap::Subcommand)]
 pub enum BtfCommand {
@@ -527,7 +309,13 @@ pub enum BtfCommand {
     /// image.
     Stats(StatsArgs),
     /// Render a mesh with UVs textured by a compressed BTF under one light (§5.5), to PNG.
-    Render(RenderArgs),
+    Render(super::btf_render::RenderArgs),
+    /// Fin BTFs for silhouette enhancement of fuzzy cloth (§5.7): synth, compress.
+    Fins {
+        /// What to do.
+        #[command(subcommand)]
+        command: super::btf_fins::FinsCommand,
+    },
 }
 
 impl BtfCommand {
@@ -560,6 +348,7 @@ impl BtfCommand {
             .line(),
             Self::Stats(a) => run_stats(&a.dir, &a.file, false)?.line(),
             Self::Render(a) => a.run()?,
+            Self::Fins { command } => command.run()?,
         };
         super::print_line(&line)
     }
@@ -619,80 +408,6 @@ pub struct StatsArgs {
     file: PathBuf,
 }
 
-/// `cloth-vis btf render`.
-#[derive(clap::Args)]
-pub struct RenderArgs {
-    /// A mesh with per-vertex UVs (.obj .ply .gltf .glb) or synth:cloth.
-    mesh: PathBuf,
-    /// The .btfpca material.
-    #[arg(long)]
-    btf: PathBuf,
-    /// Directional light: world direction towards it.
-    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, conflicts_with = "light_pos")]
-    light_dir: Option<Vec3>,
-    /// Point light: world position (no distance falloff).
-    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3)]
-    light_pos: Option<Vec3>,
-    /// Linear RGB radiance of the light.
-    #[arg(long, value_name = "R,G,B", value_parser = super::parse::vec3, default_value = "1,1,1")]
-    radiance: Vec3,
-    /// Direction from the mesh towards the camera, which frames the mesh (Y-up; turned with
-    /// --up-axis).
-    #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, default_value = "0.55,0.45,1")]
-    camera_dir: Vec3,
-    /// The mesh's up axis: the camera turns onto it (z for Blender/CAD exports such as the
-    /// Berkeley garments); --light-dir/--light-pos stay in the mesh's coordinates.
-    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
-    up_axis: super::up_axis::UpAxis,
-    /// Image size.
-    #[arg(long, value_name = "WxH", value_parser = super::parse::size, default_value = "512x512")]
-    size: [u32; 2],
-    /// Texture repeats across the mesh's UV range.
-    #[arg(long, default_value_t = 4.0)]
-    uv_scale: f32,
-    /// Also draw plain texture mapping of the same material beside it (Fig. 5.16).
-    #[arg(long)]
-    beside_plain: bool,
-    /// Use the CPU reference renderer (no GPU needed).
-    #[arg(long)]
-    cpu: bool,
-    /// Output: IMAGE.png.
-    #[arg(long)]
-    out: PathBuf,
-}
-
-impl RenderArgs {
-    /// Render; the summary line.
-    fn run(self) -> anyhow::Result<String> {
-        let light = match (self.light_dir, self.light_pos) {
-            (Some(d), _) => RenderLight::Direction(d),
-            (None, Some(p)) => RenderLight::Position(p),
-            (None, None) => {
-                anyhow::bail!("give the light: --light-dir X,Y,Z or --light-pos X,Y,Z")
-            }
-        };
-        let gpu = if self.cpu {
-            None
-        } else {
-            super::optional_gpu()
-        };
-        let request = RenderRequest {
-            mesh: self.mesh,
-            btf: self.btf,
-            light,
-            radiance: self.radiance,
-            camera_direction: self.camera_dir,
-            up_axis: self.up_axis,
-            size: self.size,
-            uv_scale: self.uv_scale,
-            beside_plain: self.beside_plain,
-            cpu: self.cpu,
-            out: self.out,
-        };
-        Ok(run_render(&request, gpu.as_ref())?.line())
-    }
-}
-
 fn parse_sampling(text: &str) -> Result<Sampling, String> {
     match text.to_ascii_lowercase().as_str() {
         "h1" => Ok(Sampling::H1),
@@ -701,7 +416,7 @@ fn parse_sampling(text: &str) -> Result<Sampling, String> {
     }
 }
 
-fn parse_storage(text: &str) -> Result<btf::Storage, String> {
+pub(super) fn parse_storage(text: &str) -> Result<btf::Storage, String> {
     match text.to_ascii_lowercase().as_str() {
         "u8" => Ok(btf::Storage::U8),
         "u16" => Ok(btf::Storage::U16),

@@ -5,6 +5,8 @@
 pub mod anim;
 pub mod bake;
 pub mod btf;
+pub mod btf_fins;
+pub mod btf_render;
 pub mod cpca;
 mod cpca_bits;
 mod cpca_decompress;

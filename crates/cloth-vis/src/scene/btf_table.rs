@@ -36,6 +36,24 @@ pub struct BtfDesc {
     /// The picture: the BTF on the left, plain texture mapping on the right.
     #[serde(default = "default_btf_png")]
     pub png: String,
+    /// Fins along the BTF objects' silhouettes (§5.7), drawn on the BTF half of the picture.
+    #[serde(default)]
+    pub fins: Option<FinsDesc>,
+}
+
+/// `[btf] fins = { source = "synth:wool" | "FILE.finpca", height = H, size = S }`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FinsDesc {
+    /// `synth:wool` (the synthetic wool, rendered and compressed in memory) or a `.finpca`
+    /// file (relative to the scene file).
+    pub source: String,
+    /// Fin height in material units (default 1: the whole fin image).
+    #[serde(default)]
+    pub height: Option<f32>,
+    /// World length of one material unit (default 4 % of the BTF objects' bounding radius).
+    #[serde(default)]
+    pub size: Option<f32>,
 }
 
 fn default_btf_source() -> String {
@@ -71,6 +89,7 @@ impl Default for BtfDesc {
             radiance: default_btf_radiance(),
             uv_scale: default_btf_uv_scale(),
             png: default_btf_png(),
+            fins: None,
         }
     }
 }
@@ -120,6 +139,25 @@ impl Scene {
                 "btf.uv_scale",
                 format!("{} must be finite and > 0", b.uv_scale),
             ));
+        }
+        if let Some(f) = &b.fins {
+            if f.source != crate::fins_stage::SYNTH_WOOL {
+                let path = self.base_dir.join(&f.source);
+                if !path.is_file() {
+                    return Err(self.invalid(
+                        "btf.fins.source",
+                        format!(
+                            "{} is not a file; give a .finpca or \"synth:wool\"",
+                            path.display()
+                        ),
+                    ));
+                }
+            }
+            for (key, v) in [("btf.fins.height", f.height), ("btf.fins.size", f.size)] {
+                if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0 && *v < 1e9)) {
+                    return Err(self.invalid(key, format!("{v} must be finite and > 0")));
+                }
+            }
         }
         if Path::new(&b.png)
             .file_name()

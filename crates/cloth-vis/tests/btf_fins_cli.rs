@@ -1,0 +1,265 @@
+//! `cloth-vis btf fins synth | compress` and `btf render --fins` through the binary (thesis
+//! §5.7): the synthetic wool at 32² in the fin folder layout, its PCA (c = 16 by default, exact
+//! with every component), refused input naming the file, and fins that change only the pixels
+//! along the silhouette.
+
+mod common;
+
+use std::path::Path;
+use std::process::Output;
+
+use btf::fin_pca::{FinDir, FinPca, fin_image_name};
+use image::GenericImageView as _;
+
+use common::{cli, text};
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn synth(dir: &Path) -> Output {
+    cli(&[
+        "btf",
+        "fins",
+        "synth",
+        "--size",
+        "32x32",
+        "--out",
+        text(dir),
+        "--quiet",
+    ])
+}
+
+#[test]
+fn synth_then_compress_keeps_16_components_and_all_80_reconstruct_exactly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("wool");
+    let out = synth(&dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("81 images of 32x32"),
+        "{}",
+        stdout(&out)
+    );
+    let folder = FinDir::open(&dir).unwrap();
+    assert_eq!((folder.width(), folder.height()), (32, 32));
+    assert!(dir.join(fin_image_name(44, "png")).is_file());
+    let names: Vec<_> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("wool")]);
+    // Alpha falls off at the tips: the base rows of the overhead-lit image are brighter.
+    let overhead = image::open(dir.join(fin_image_name(0, "png")))
+        .unwrap()
+        .to_rgb8();
+    let band = |rows: std::ops::Range<u32>| {
+        rows.flat_map(|y| (0..32).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                overhead
+                    .get_pixel(x, y)
+                    .0
+                    .iter()
+                    .map(|&c| u32::from(c))
+                    .sum::<u32>()
+            })
+            .sum::<u32>()
+    };
+    assert!(
+        band(24..32) > 3 * band(0..8),
+        "base {} tips {}",
+        band(24..32),
+        band(0..8)
+    );
+
+    let file = tmp.path().join("wool.finpca");
+    let out = cli(&["btf", "fins", "compress", text(&dir), "--out", text(&file)]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("c = 16 (asked 16)"),
+        "{}",
+        stdout(&out)
+    );
+    let fins = FinPca::read(&file).unwrap();
+    assert_eq!(fins.slot().components(), 16);
+
+    let exact = tmp.path().join("exact.finpca");
+    let out = cli(&[
+        "btf",
+        "fins",
+        "compress",
+        text(&dir),
+        "--components",
+        "80",
+        "--storage",
+        "f32",
+        "--mean-storage",
+        "f32",
+        "--out",
+        text(&exact),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let images = folder.load().unwrap();
+    let stats = FinPca::read(&exact).unwrap().stats(&images).unwrap();
+    assert!(stats.max_abs_srgb8 < 0.01, "{stats:?}");
+}
+
+#[test]
+fn bad_fin_input_is_refused_naming_the_file_and_nothing_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("wool");
+    assert!(synth(&dir).status.success());
+    // Synthesising into a folder with files is refused.
+    let out = synth(&dir);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("not an empty folder"),
+        "{}",
+        stderr(&out)
+    );
+    // A wrong output name, c = 0.
+    let btfpca = tmp.path().join("wool.btfpca");
+    let out = cli(&[
+        "btf",
+        "fins",
+        "compress",
+        text(&dir),
+        "--out",
+        text(&btfpca),
+    ]);
+    assert!(!out.status.success() && stderr(&out).contains(".finpca"));
+    assert!(!btfpca.exists());
+    let file = tmp.path().join("wool.finpca");
+    let out = cli(&[
+        "btf",
+        "fins",
+        "compress",
+        text(&dir),
+        "--components",
+        "0",
+        "--out",
+        text(&file),
+    ]);
+    assert!(!out.status.success() && stderr(&out).contains("--components 0"));
+    // A missing light image is named.
+    std::fs::remove_file(dir.join(fin_image_name(20, "png"))).unwrap();
+    let out = cli(&["btf", "fins", "compress", text(&dir), "--out", text(&file)]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains(&fin_image_name(20, "png")),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!file.exists());
+    // A .finpca that is not one, given to render: named.
+    std::fs::write(&file, b"not a fin file").unwrap();
+    let out = cli(&[
+        "btf",
+        "render",
+        "synth:sphere",
+        "--btf",
+        text(&file),
+        "--light-dir",
+        "0,1,1",
+        "--fins",
+        text(&file),
+        "--cpu",
+        "--out",
+        text(&tmp.path().join("x.png")),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("--cpu"),
+        "--fins conflicts with --cpu: {}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn fins_change_only_the_pixels_along_the_silhouette() {
+    if gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()).is_err() {
+        test_data::skip::<()>("no GPU adapter for the fin render test");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let woven = tmp.path().join("w");
+    let btf_file = tmp.path().join("w.btfpca");
+    let args = [
+        "btf",
+        "synth",
+        "--res",
+        "16",
+        "--out",
+        text(&woven),
+        "--quiet",
+    ];
+    assert!(cli(&args).status.success());
+    let args = [
+        "btf",
+        "compress",
+        text(&woven),
+        "--out",
+        text(&btf_file),
+        "--quiet",
+    ];
+    assert!(cli(&args).status.success());
+    let render = |extra: &[&str], out: &Path| {
+        let mut args = vec![
+            "btf",
+            "render",
+            "synth:sphere",
+            "--btf",
+            text(&btf_file),
+            "--light-dir",
+            "0.2,0.7,0.7",
+            "--size",
+            "128x128",
+            "--out",
+            text(out),
+        ];
+        args.extend_from_slice(extra);
+        cli(&args)
+    };
+    let plain = tmp.path().join("plain.png");
+    let out = render(&[], &plain);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let both = tmp.path().join("both.png");
+    let out = render(&["--fins", "synth:wool", "--beside-no-fins"], &both);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("fins: "), "{}", stdout(&out));
+    let plain = image::open(&plain).unwrap().to_rgb8();
+    let both = image::open(&both).unwrap().to_rgb8();
+    assert_eq!(both.dimensions(), (256, 128));
+    let without = both.view(0, 0, 128, 128).to_image();
+    let with = both.view(128, 0, 128, 128).to_image();
+    assert_eq!(
+        without.as_raw(),
+        plain.as_raw(),
+        "left half = the render without fins"
+    );
+    // Every changed pixel lies within 5 pixels of the sphere's outline, and some change.
+    let covered = |x: i32, y: i32| {
+        (0..128).contains(&x)
+            && (0..128).contains(&y)
+            && plain.get_pixel(x as u32, y as u32).0 != [0; 3]
+    };
+    let near_outline = |x: i32, y: i32| {
+        let c = covered(x, y);
+        (-5..=5).any(|dy| (-5..=5).any(|dx| covered(x + dx, y + dy) != c))
+    };
+    let mut changed = 0;
+    for (x, y, p) in with.enumerate_pixels() {
+        if p != without.get_pixel(x, y) {
+            changed += 1;
+            assert!(
+                near_outline(x as i32, y as i32),
+                "pixel ({x}, {y}) changed inside"
+            );
+        }
+    }
+    assert!(changed > 100, "only {changed} pixels carry fins");
+}
