@@ -47,6 +47,7 @@ mod compare_translucency;
 mod python;
 mod repro_anim_compression;
 mod repro_btf;
+mod repro_fins;
 mod repro_hemicube;
 mod repro_jumpmap;
 mod repro_lightsphere;
@@ -160,6 +161,9 @@ enum Repro {
         #[arg(long)]
         quick: bool,
     },
+    /// BTF fins (§5.7): the wool's PCA against c, fin extraction per frame on the drape,
+    /// Figs. 5.23/5.24 with and without fins and the fins' share of the frame.
+    Fins,
     /// Shadow volumes (thesis §2.4.1, §4.2, §5.5.1): the LOD chain on the bunny (Hausdorff,
     /// mask error, soft-mask error, build and mask times), the zig-zag against tessellation,
     /// popping under sun motion on the drape.
@@ -214,6 +218,7 @@ fn main() -> anyhow::Result<()> {
         Command::Repro {
             what: Repro::Hemicube { quick },
         } => repro_hemicube::run(&repro_dir()?, quick),
+        Command::Repro { what: Repro::Fins } => repro_fins::run(&repro_dir()?),
         Command::Repro {
             what: Repro::Shadows { quick },
         } => repro_shadows::run(&repro_dir()?, quick),

@@ -1,6 +1,8 @@
 //! Named adversarial cases of light/view interpolation and per-view PCA (DESIGN.md, "Hard
 //! cases stay numerically stable"), and of the BTF folder reader (issue #12): image headers
-//! that claim more pixels than their files hold, and a FIFO named like an image.
+//! that claim more pixels than their files hold, and a FIFO named like an image; fin geometry
+//! (no silhouette, border, crease, offset 1e5) and the fin BTF (black and constant image sets,
+//! the alpha cut, a 10⁴× light).
 
 mod common;
 
@@ -524,5 +526,79 @@ mod fins {
                     .all(|t| t.is_finite())
             );
         }
+    }
+}
+
+/// The fin BTF (§5.7.2): degenerate image sets and the alpha cut.
+mod fin_btf {
+    use btf::fin_pca::{ALPHA_CUT, FIN_SAMPLING, FinPca, fin_alpha};
+    use btf::render::{FinShading, fin_fragment};
+    use btf::{BtfPcaParams, DIRECTIONS, ViewSlot};
+    use glam::Vec3;
+
+    #[test]
+    fn a_bald_material_whose_81_images_are_black() {
+        let images = ViewSlot::new(0, 4, 4, vec![0.0; DIRECTIONS * 48]).unwrap();
+        let fins = FinPca::from_images(&images, &BtfPcaParams::default()).unwrap();
+        // Rank 0: only the mean, and every fragment is fully transparent.
+        assert_eq!(fins.slot().components(), 0);
+        let g = fins.gamma(Vec3::new(0.3, 0.2, 0.9));
+        let f = fin_fragment(
+            &fins,
+            [&g, &g],
+            Vec3::splat(1e4),
+            [0.3, 0.5],
+            0.5,
+            &Default::default(),
+        );
+        assert_eq!(f, [0.0; 4]);
+        assert_eq!(FinPca::from_bytes(&fins.to_bytes()).unwrap(), fins);
+    }
+
+    #[test]
+    fn identical_images_under_every_light() {
+        let data: Vec<f32> = (0..DIRECTIONS)
+            .flat_map(|_| (0..12).map(|v| v as f32 / 24.0))
+            .collect();
+        let images = ViewSlot::new(0, 2, 2, data).unwrap();
+        let fins = FinPca::from_images(&images, &BtfPcaParams::default()).unwrap();
+        assert_eq!(fins.slot().components(), 0);
+        // Any light between measured directions: the τ sum to 1, so the image itself.
+        let g = fins.gamma(Vec3::new(0.41, -0.33, 0.6).normalize());
+        let t = fins.texel(&g, 1, 1);
+        for (c, want) in t.iter().zip([9.0 / 24.0, 10.0 / 24.0, 11.0 / 24.0]) {
+            assert!((c - want).abs() < 1e-4, "{t:?}");
+        }
+    }
+
+    #[test]
+    fn alpha_exactly_at_the_cut_and_a_sun_far_above_one() {
+        // r + g + b exactly at the cut is kept (Listing 5.1: alpha >= 0.04); just below, cut.
+        assert_eq!(fin_alpha([0.02, 0.01, 0.01], ALPHA_CUT), 0.04);
+        assert_eq!(fin_alpha([0.02, 0.01, 0.0099], ALPHA_CUT), 0.0);
+        // A light 10⁴ times brighter than the images' scale: alpha clamps to 1, colour stays
+        // finite (premultiplied colour may exceed 1: HDR, tone-mapped later).
+        let data: Vec<f32> = (0..DIRECTIONS)
+            .flat_map(|i| [0.2 * FIN_SAMPLING.vector(i).z; 3])
+            .collect();
+        let fins = FinPca::from_images(
+            &ViewSlot::new(0, 1, 1, data).unwrap(),
+            &BtfPcaParams::default(),
+        )
+        .unwrap();
+        let g = fins.gamma(Vec3::Z);
+        let f = fin_fragment(
+            &fins,
+            [&g, &g],
+            Vec3::splat(1e4),
+            [0.0, 0.5],
+            0.0,
+            &FinShading::default(),
+        );
+        assert_eq!(f[3], 1.0);
+        assert!(
+            f.iter().all(|c| c.is_finite()) && (f[0] - 2e3).abs() < 2.0,
+            "{f:?}"
+        );
     }
 }

@@ -98,3 +98,52 @@ impl WorldObject {
         }
     }
 }
+
+/// A unit UV sphere with texture coordinates (the sphere of the thesis's Fig. 5.23):
+/// positions, triangles and UVs (u around the axis, v from the top pole, each 0..1) of
+/// `rings` × `segments` quads (`rings, segments ≥ 2`); the positions are also the normals.
+/// The seam column (u = 1) and each pole ring repeat their vertices for the UVs, at exactly
+/// the same positions, so a position weld closes the surface.
+///
+/// ```
+/// let (p, t, uv) = cloth_vis::object::uv_sphere(8, 16);
+/// assert_eq!((p.len(), uv.len(), t.len()), (9 * 17, 9 * 17, 2 * 8 * 16 - 2 * 16));
+/// assert!(p.iter().all(|p| (p.length() - 1.0).abs() < 1e-6));
+/// ```
+pub fn uv_sphere(rings: u32, segments: u32) -> (Vec<Vec3>, Vec<[u32; 3]>, Vec<Vec2>) {
+    let (rings, segments) = (rings.max(2), segments.max(2));
+    let mut positions = Vec::new();
+    let mut uvs = Vec::new();
+    for r in 0..=rings {
+        let v = r as f32 / rings as f32;
+        let theta = v * std::f32::consts::PI;
+        for s in 0..=segments {
+            let u = s as f32 / segments as f32;
+            // The seam column repeats column 0 and the poles are exact, bit for bit, so the
+            // fins see one closed surface (`fins_stage::welded_triangles`).
+            let phi = (s % segments) as f32 / segments as f32 * std::f32::consts::TAU;
+            let (sin_t, cos_t) = match r {
+                0 => (0.0, 1.0),
+                _ if r == rings => (0.0, -1.0),
+                _ => (theta.sin(), theta.cos()),
+            };
+            positions.push(Vec3::new(sin_t * phi.cos(), cos_t, -sin_t * phi.sin()));
+            uvs.push(Vec2::new(u, v));
+        }
+    }
+    let row = segments + 1;
+    let mut triangles = Vec::new();
+    for r in 0..rings {
+        for s in 0..segments {
+            let (a, b) = (r * row + s, r * row + s + 1);
+            let (c, d) = (a + row, b + row);
+            if r > 0 {
+                triangles.push([a, c, b]);
+            }
+            if r + 1 < rings {
+                triangles.push([b, c, d]);
+            }
+        }
+    }
+    (positions, triangles, uvs)
+}

@@ -79,7 +79,6 @@ fn bad_btf_tables_are_named_before_any_work() {
             "fins = { source = \"synth:wool\", size = nan }",
             "btf.fins.size",
         ),
-        ("fins = { source = \"synth:wool\", colour = 1 }", "colour"),
     ] {
         let text = format!("effects = [\"btf\"]\n{CLOTH}\n[btf]\n{table}\n");
         let err = Plan::for_scene(&scene(&text, dir.path()))

@@ -18,7 +18,10 @@
 //! n overlapping fins give Π(1 − α_i) · dst + Σ c_i in any order, up to float rounding
 //! (tested with shuffled fins). The price: fins do not hide each other — where two overlap,
 //! the nearer one's (1 − α) does not dim the farther one's colour, an error of α_near · c_far,
-//! second order in the fibres' coverage. The colour is treated as premultiplied (the images
+//! second order in the fibres' coverage — except where many fins pile up on one spot: a
+//! silhouette that zig-zags across the fan of a UV sphere's pole stacks dozens of short fins,
+//! and their summed light shows as a bright spot that "over" would have capped at one fin's
+//! colour (`cargo xtask repro fins`, Fig. 5.23). The colour is treated as premultiplied (the images
 //! are fibres over black, so coverage is already in them) rather than multiplied by alpha a
 //! second time as SRC_ALPHA does. Fins test depth against the opaque surface, so the mesh
 //! hides the fins behind it.

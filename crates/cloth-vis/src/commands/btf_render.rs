@@ -120,7 +120,9 @@ fn render_mesh(path: &Path) -> Result<cloth_vis::object::WorldObject, Error> {
             normals,
         )
     } else if path == Path::new("synth:sphere") {
-        uv_sphere(48, 96)
+        let (positions, triangles, uvs) = cloth_vis::object::uv_sphere(48, 96);
+        let normals = positions.clone();
+        (positions, triangles, Some(uvs), normals)
     } else {
         // UV seams (sewing-pattern garments) split into vertex copies; the normals stay those
         // of the welded mesh, so the seams do not show in the shading.
@@ -151,47 +153,6 @@ fn render_mesh(path: &Path) -> Result<cloth_vis::object::WorldObject, Error> {
         back: None,
         animation: None,
     })
-}
-
-/// A unit UV sphere (Fig. 5.23's object): `rings` × `segments` quads with a seam column of
-/// duplicated vertices at u = 1 and one vertex per pole ring corner, so u and v are continuous.
-type UvMesh = (Vec<Vec3>, Vec<[u32; 3]>, Option<Vec<glam::Vec2>>, Vec<Vec3>);
-fn uv_sphere(rings: u32, segments: u32) -> UvMesh {
-    let mut positions = Vec::new();
-    let mut uvs = Vec::new();
-    for r in 0..=rings {
-        let v = r as f32 / rings as f32;
-        let theta = v * std::f32::consts::PI;
-        for s in 0..=segments {
-            let u = s as f32 / segments as f32;
-            // The seam column repeats column 0 and the poles are exact, bit for bit, so the
-            // fins see one closed surface (`fins_stage::welded_triangles`).
-            let phi = (s % segments) as f32 / segments as f32 * std::f32::consts::TAU;
-            let (sin_t, cos_t) = match r {
-                0 => (0.0, 1.0),
-                _ if r == rings => (0.0, -1.0),
-                _ => (theta.sin(), theta.cos()),
-            };
-            positions.push(Vec3::new(sin_t * phi.cos(), cos_t, -sin_t * phi.sin()));
-            uvs.push(glam::Vec2::new(u, v));
-        }
-    }
-    let row = segments + 1;
-    let mut triangles = Vec::new();
-    for r in 0..rings {
-        for s in 0..segments {
-            let (a, b) = (r * row + s, r * row + s + 1);
-            let (c, d) = (a + row, b + row);
-            if r > 0 {
-                triangles.push([a, c, b]);
-            }
-            if r + 1 < rings {
-                triangles.push([b, c, d]);
-            }
-        }
-    }
-    let normals = positions.clone();
-    (positions, triangles, Some(uvs), normals)
 }
 
 /// Runs `btf render`: the mesh textured by the compressed BTF under one light (thesis §5.5),
