@@ -234,7 +234,16 @@ pub(crate) fn parse(bytes: &[u8], path: &Path, kind: &Kind) -> Result<BtfPca> {
     };
     let magic = r.take(8, "magic")?;
     if magic != kind.magic {
-        return Err(r.bad("magic", format!("{magic:02x?}"), kind.name));
+        let reason = match magic {
+            m if m == crate::fin_pca::FIN_MAGIC => {
+                "this is a .finpca (a fin BTF, §5.7): read it with FinPca::read / pass it to --fins"
+            }
+            m if m == MAGIC => {
+                "this is a .btfpca (a per-view BTF): read it with BtfPca::read / pass it to --btf"
+            }
+            _ => kind.name,
+        };
+        return Err(r.bad("magic", format!("{magic:02x?}"), reason));
     }
     let vb = r.take(2, "version")?;
     let version = u16::from_le_bytes([vb[0], vb[1]]);

@@ -333,10 +333,10 @@ pub struct RenderArgs {
     #[arg(long, value_name = "FILE.finpca|synth:wool", conflicts_with_all = ["beside_plain", "cpu"])]
     fins: Option<String>,
     /// Fin height in material units (default 1: the whole fin image).
-    #[arg(long, requires = "fins")]
+    #[arg(long, requires = "fins", allow_hyphen_values = true)]
     fin_height: Option<f32>,
     /// World length of one fin material unit (default 4 % of the mesh's bounding radius).
-    #[arg(long, requires = "fins")]
+    #[arg(long, requires = "fins", allow_hyphen_values = true)]
     fin_size: Option<f32>,
     /// Draw the mesh without fins on the left, with fins on the right (Figs. 5.23/5.24).
     #[arg(long, requires = "fins")]
