@@ -26,7 +26,8 @@
 //!   alpha of Listing 5.1) — §5.7.2.
 //!
 //! γ is computed apart from the texel sum so that environment illumination (γ*, §5.5.2) can
-//! accumulate many light directions into it ([`BtfPca::accumulate_gamma`]). Background: the
+//! accumulate many light directions into it ([`BtfPca::accumulate_gamma`]); [`env`](mod@env) does so
+//! for an environment seen through a per-vertex visibility matrix (eqs. 5.10–5.11, RGB γ*). Background: the
 //! BTF as a set of textures or of apparent BRDFs and its compression by per-view
 //! factorisation are surveyed in §2.1.10–2.1.12; [`compare`](mod@compare) sets per-view
 //! factorisation beside full-matrix and per-cluster factorisation of the texels' ABRDFs
@@ -71,6 +72,7 @@
 pub mod compare;
 pub mod compress;
 pub mod dataset;
+pub mod env;
 mod error;
 pub mod fin_pca;
 pub mod fins;

@@ -32,6 +32,8 @@
 //!   forward-scattering lobe and self-shadowing through the fibre cloud. Each
 //!   [`FinImage`] is premultiplied RGB with the fibre coverage as alpha, falling off at the
 //!   tips.
+//! * [`LambertianBtf`]: a BTF without mesostructure (every image ρ · cos θ_l), the oracle of
+//!   environment lighting — under a uniform sky with nothing in the way it reflects ρ L.
 //!
 //! No seed section specifies this crate, so no seed equation is implemented here; the
 //! methods are cited in each module (Macklin et al. 2016/2019 for XPBD, Bergou et al. 2006
@@ -69,8 +71,8 @@ mod rng;
 mod sky;
 
 pub use btf::{
-    MAX_SUPERSAMPLE, MAX_WOVEN_SAMPLES, MAX_YARNS, MIN_VIEW_ELEVATION_DEG, SurfacePoint, ViewHits,
-    WovenBtf, WovenBtfParams, Yarn,
+    LambertianBtf, MAX_SUPERSAMPLE, MAX_WOVEN_SAMPLES, MAX_YARNS, MIN_VIEW_ELEVATION_DEG,
+    SurfacePoint, ViewHits, WovenBtf, WovenBtfParams, Yarn,
 };
 pub use cloth::{
     ClothAnimation, ClothParams, MAX_GRID, MAX_OBSTACLE_DETAIL, MAX_POSITIONS,

@@ -66,11 +66,13 @@
 //! edges.
 
 mod bound;
+mod lambertian;
 mod march;
 mod render;
 mod shadow;
 mod weave;
 
+pub use lambertian::LambertianBtf;
 pub use render::ViewHits;
 
 use crate::error::{Result, SynthError, check_finite3, check_range};
