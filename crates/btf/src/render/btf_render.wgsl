@@ -17,7 +17,8 @@ struct Frame {
     uv_scale: vec4<f32>,
     // x, y: normtexture width and height; z: tiles along x per slice; w: tiles per slice.
     tex: vec4<u32>,
-    // x: γ stride (max c_j + 1); y: u32 words per vertex record (8 + 4 · γ stride).
+    // x: γ stride (max c_j + 1, times 3 with RGB γ*); y: u32 words per vertex record
+    // (8 + 4 · γ stride); z: 1 when γ is RGB (environment light, §5.5.2), else 0.
     strides: vec4<u32>,
 }
 
@@ -107,8 +108,18 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
             let g_base = base + 8u + m * frame.strides.x;
             var t = vec3<f32>(0.0);
             for (var k = 0u; k < slot.y; k++) {
-                let g = bitcast<f32>(records[g_base + k]);
-                if g == 0.0 {
+                var g: vec3<f32>;
+                if frame.strides.z != 0u {
+                    let r = g_base + 3u * k;
+                    g = vec3<f32>(
+                        bitcast<f32>(records[r]),
+                        bitcast<f32>(records[r + 1u]),
+                        bitcast<f32>(records[r + 2u]),
+                    );
+                } else {
+                    g = vec3<f32>(bitcast<f32>(records[g_base + k]));
+                }
+                if all(g == vec3<f32>(0.0)) {
                     continue;
                 }
                 let info = layers[slot.x + k];

@@ -7,6 +7,7 @@ use rayon::prelude::*;
 use super::image::RenderedImage;
 use super::mesh::{BtfMesh, Camera, Light, RenderParams};
 use super::shade::VertexShading;
+use crate::env::EnvLightWeights;
 use crate::error::Result;
 use crate::model::BtfPca;
 
@@ -42,15 +43,58 @@ pub fn render_cpu(
     camera: &Camera,
     params: &RenderParams,
 ) -> Result<RenderedImage> {
-    let clip_from_world = camera.clip_from_world()?;
     light.validate()?;
-    params.validate()?;
     let frames = mesh.frames()?;
     let shading = VertexShading::compute(pca, mesh, &frames, light, camera.eye);
+    render_shaded(pca, mesh, &shading, light.radiance(), camera, params)
+}
+
+/// Renders `mesh` textured by `pca` under an environment on the CPU (thesis §5.5.2): as
+/// [`render_cpu`], with RGB γ* per vertex and slot from `w[v]`, the environment binned for
+/// vertex v ([`crate::env`]; its visibility and radiance are already in it).
+///
+/// # Errors
+/// As [`render_cpu`]; [`crate::BtfError::LengthMismatch`] unless `w` has one entry per
+/// vertex.
+pub fn render_cpu_env(
+    pca: &BtfPca,
+    mesh: &BtfMesh<'_>,
+    w: &[EnvLightWeights],
+    camera: &Camera,
+    params: &RenderParams,
+) -> Result<RenderedImage> {
+    check_env_len(mesh, w)?;
+    let frames = mesh.frames()?;
+    let shading = VertexShading::compute_env(pca, mesh, &frames, w, camera.eye);
+    render_shaded(pca, mesh, &shading, Vec3::ONE, camera, params)
+}
+
+/// One environment entry per vertex.
+pub(crate) fn check_env_len(mesh: &BtfMesh<'_>, w: &[EnvLightWeights]) -> Result<()> {
+    if w.len() != mesh.positions.len() {
+        return Err(crate::BtfError::LengthMismatch {
+            what: "environment weights per vertex",
+            expected: mesh.positions.len(),
+            found: w.len(),
+            hint: "bin the environment for every vertex (EnvTransfer::update)",
+        });
+    }
+    Ok(())
+}
+
+fn render_shaded(
+    pca: &BtfPca,
+    mesh: &BtfMesh<'_>,
+    shading: &VertexShading,
+    radiance: Vec3,
+    camera: &Camera,
+    params: &RenderParams,
+) -> Result<RenderedImage> {
+    let clip_from_world = camera.clip_from_world()?;
+    params.validate()?;
     let (w, h) = (camera.width as usize, camera.height as usize);
     let fragments = rasterize(mesh, clip_from_world, w, h);
 
-    let radiance = light.radiance();
     let mut pixels = vec![params.background.to_array(); w * h];
     pixels
         .par_chunks_mut(w)
@@ -58,7 +102,7 @@ pub fn render_cpu(
         .for_each(|(row, frags)| {
             for (px, frag) in row.iter_mut().zip(frags) {
                 if let Some(f) = frag {
-                    let rgb = shade_fragment(pca, mesh, &shading, f, params.uv_scale);
+                    let rgb = shade_fragment(pca, mesh, shading, f, params.uv_scale);
                     *px = (radiance * Vec3::from_array(rgb)).to_array();
                 }
             }
@@ -93,8 +137,15 @@ fn shade_fragment(
                 continue;
             }
             let j = shading.slots[v][m] as usize;
-            let gamma = &shading.gamma(v, m)[..pca.gamma_len(j)];
-            let t = pca.texel(j, gamma, x, y);
+            let t = if shading.rgb {
+                let g = shading.gamma(v, m);
+                let rgb: Vec<Vec3> = (0..pca.gamma_len(j))
+                    .map(|k| Vec3::new(g[3 * k], g[3 * k + 1], g[3 * k + 2]))
+                    .collect();
+                pca.texel_rgb(j, &rgb, x, y)
+            } else {
+                pca.texel(j, &shading.gamma(v, m)[..pca.gamma_len(j)], x, y)
+            };
             for (o, t) in texture.iter_mut().zip(t) {
                 *o += omega * t;
             }

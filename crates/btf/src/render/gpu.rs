@@ -401,10 +401,41 @@ impl GpuBtfRenderer {
         camera: &Camera,
         params: &RenderParams,
     ) -> Result<BtfDraw> {
-        camera.validate()?;
         light.validate()?;
-        params.validate()?;
         let frames = mesh.frames()?;
+        let shading = VertexShading::compute(&self.weights_only, mesh, &frames, light, camera.eye);
+        self.upload(mesh, &shading, light.radiance(), camera, params)
+    }
+
+    /// As [`Self::prepare`] under an environment (thesis §5.5.2): `w[v]` is the environment
+    /// binned for vertex v ([`crate::env`]: its radiance, solid angles and visibility), and
+    /// each vertex carries RGB γ* per view slot (eq. 5.11).
+    ///
+    /// # Errors
+    /// As [`Self::prepare`]; [`BtfError::LengthMismatch`] unless `w` has one entry per vertex.
+    pub fn prepare_env(
+        &self,
+        mesh: &BtfMesh<'_>,
+        w: &[crate::env::EnvLightWeights],
+        camera: &Camera,
+        params: &RenderParams,
+    ) -> Result<BtfDraw> {
+        super::cpu::check_env_len(mesh, w)?;
+        let frames = mesh.frames()?;
+        let shading = VertexShading::compute_env(&self.weights_only, mesh, &frames, w, camera.eye);
+        self.upload(mesh, &shading, glam::Vec3::ONE, camera, params)
+    }
+
+    fn upload(
+        &self,
+        mesh: &BtfMesh<'_>,
+        shading: &VertexShading,
+        radiance: glam::Vec3,
+        camera: &Camera,
+        params: &RenderParams,
+    ) -> Result<BtfDraw> {
+        camera.validate()?;
+        params.validate()?;
         let device = &self.device;
         let max_2d = device.limits().max_texture_dimension_2d;
         for (what, value) in [
@@ -421,7 +452,6 @@ impl GpuBtfRenderer {
                 });
             }
         }
-        let shading = VertexShading::compute(&self.weights_only, mesh, &frames, light, camera.eye);
         let stride = shading.gamma_stride;
         let record_words = RECORD_HEADER + 4 * stride;
         let n = mesh.positions.len();
@@ -451,7 +481,7 @@ impl GpuBtfRenderer {
             })
             .collect();
         let uniform = FrameUniform {
-            radiance: light.radiance().extend(0.0).to_array(),
+            radiance: radiance.extend(0.0).to_array(),
             uv_scale: [params.uv_scale.x, params.uv_scale.y, 0.0, 0.0],
             tex: [
                 self.width,
@@ -460,7 +490,12 @@ impl GpuBtfRenderer {
                 self.tiling.tiles_per_slice,
             ],
             // Fits u32: the records buffer was checked above.
-            strides: [stride as u32, record_words as u32, 0, 0],
+            strides: [
+                stride as u32,
+                record_words as u32,
+                u32::from(shading.rgb),
+                0,
+            ],
         };
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("btf frame"),

@@ -106,7 +106,7 @@ mod mesh;
 mod shade;
 mod tangent;
 
-pub use cpu::render_cpu;
+pub use cpu::{render_cpu, render_cpu_env};
 pub use fin_shade::{FinShading, fin_fragment, fin_gammas};
 #[cfg(feature = "gpu")]
 pub use fins_gpu::{FinDraw, GpuFinRenderer};

@@ -5,13 +5,18 @@
 use glam::Vec3;
 
 use super::mesh::{BtfMesh, Frame, Light};
+use crate::env::EnvLightWeights;
 use crate::model::BtfPca;
 
 /// ω, slots and γ of every vertex, in the layout uploaded to the GPU.
 #[derive(Clone, Debug)]
 pub(crate) struct VertexShading {
-    /// Length of one γ vector: max_j c_j + 1 (entries past c_j + 1 are 0).
+    /// Length of one γ vector: max_j c_j + 1 (entries past c_j + 1 are 0); three times that
+    /// with `rgb`.
     pub(crate) gamma_stride: usize,
+    /// RGB γ* (environment light, three floats per coefficient) instead of one γ per
+    /// coefficient times the light's colour.
+    pub(crate) rgb: bool,
     /// The four nearest view slots j_m of each vertex (padding repeats the first).
     pub(crate) slots: Vec<[u32; 4]>,
     /// Their weights ω_m (0 for padding).
@@ -34,6 +39,7 @@ impl VertexShading {
         let gamma_stride = pca.max_components() + 1;
         let mut out = Self {
             gamma_stride,
+            rgb: false,
             slots: vec![[0; 4]; n],
             omega: vec![[0.0; 4]; n],
             gammas: vec![0.0; n * 4 * gamma_stride],
@@ -54,6 +60,47 @@ impl VertexShading {
                 out.omega[v][m] = omega.weights[m];
                 if omega.weights[m] != 0.0 {
                     pca.gamma_from_weights(j, &tau, &mut g[..pca.gamma_len(j)]);
+                }
+            }
+        }
+        out
+    }
+
+    /// The per-vertex data under an environment: `w[v]` the environment binned for vertex v
+    /// ([`EnvLightWeights`]), γ* RGB per slot (eq. 5.11).
+    pub(crate) fn compute_env(
+        pca: &BtfPca,
+        mesh: &BtfMesh<'_>,
+        frames: &[Frame],
+        w: &[EnvLightWeights],
+        eye_world: Vec3,
+    ) -> Self {
+        let n = mesh.positions.len();
+        let coefficients = pca.max_components() + 1;
+        let gamma_stride = 3 * coefficients;
+        let mut out = Self {
+            gamma_stride,
+            rgb: true,
+            slots: vec![[0; 4]; n],
+            omega: vec![[0.0; 4]; n],
+            gammas: vec![0.0; n * 4 * gamma_stride],
+        };
+        let sampling = pca.sampling();
+        let mut scratch = vec![Vec3::ZERO; coefficients];
+        let per_vertex = out.gammas.chunks_exact_mut(4 * gamma_stride);
+        for (v, gammas) in per_vertex.enumerate() {
+            let view_in_tangent = frames[v].in_frame(eye_world - mesh.positions[v]);
+            let omega = sampling.view_weights(view_in_tangent);
+            for (m, g) in gammas.chunks_exact_mut(gamma_stride).enumerate() {
+                let j = omega.indices[m];
+                out.slots[v][m] = j as u32;
+                out.omega[v][m] = omega.weights[m];
+                if omega.weights[m] != 0.0 {
+                    let len = pca.gamma_len(j);
+                    pca.env_gamma(j, &w[v], &mut scratch[..len]);
+                    for (k, c) in scratch[..len].iter().enumerate() {
+                        g[3 * k..3 * k + 3].copy_from_slice(&c.to_array());
+                    }
                 }
             }
         }
