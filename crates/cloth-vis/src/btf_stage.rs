@@ -251,6 +251,116 @@ pub fn render_with_fins(
     ))
 }
 
+/// What lighting a BTF object by an environment cost ([`render_env`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvCost {
+    /// Lightsphere directions k.
+    pub directions: usize,
+    /// Vertices lit.
+    pub vertices: usize,
+    /// Milliseconds of the visibility matrix M (occlusion-gpu's cpu backend).
+    pub visibility_ms: f64,
+    /// Milliseconds of the per-vertex transfer T_i (once per frame of a deforming mesh).
+    pub transfer_ms: f64,
+    /// Milliseconds of the environment update: W_i = T_i · L and γ* of the four view slots
+    /// (what a new map or a turned map costs).
+    pub update_ms: f64,
+    /// Milliseconds of the frame (draw and read-back; the CPU reference without a GPU).
+    pub render_ms: f64,
+}
+
+/// Renders `object` (with UVs) with `pca` under the environment `env` (thesis §5.5.2):
+/// the visibility matrix M of the object at lightsphere `level` (self-shadowing), the
+/// environment's cell-mean radiance I_j, the per-vertex transfer and W_i (crate `btf`,
+/// module `env`), and the frame with RGB γ* — on the GPU when `gpu` is given, else the CPU
+/// reference.
+///
+/// # Errors
+/// An object without UVs; lightsphere, visibility and rendering errors.
+#[allow(clippy::too_many_arguments)] // one frame's inputs; a struct would only rename them
+pub fn render_env(
+    gpu: Option<&GpuContext>,
+    pca: &BtfPca,
+    object: &WorldObject,
+    env: &lightsphere::Environment,
+    level: u32,
+    camera: &Camera,
+    params: &RenderParams,
+) -> Result<(HdrImage, EnvCost), Error> {
+    let (tangents, uvs) = tangents_of(object)?;
+    let sphere = lightsphere::Lightsphere::new(level)?;
+    let start = Instant::now();
+    let scene = occlusion_gpu::Scene::single(
+        object.positions.clone(),
+        object.normals.clone(),
+        object.triangles.clone(),
+    )?;
+    let mut engine =
+        occlusion_gpu::VisibilityEngine::cpu(occlusion_gpu::VisibilityParams::default());
+    let m = engine.compute(&scene, &sphere)?;
+    let visibility_ms = start.elapsed().as_secs_f64() * 1e3;
+    let radiance = env.radiance_per_direction(&sphere, lightsphere::RadianceMethod::CellMean)?;
+    let frames: Vec<[Vec3; 3]> = tangents
+        .iter()
+        .zip(&object.normals)
+        .map(|(t, n)| {
+            let n = n.normalize_or_zero();
+            let t3 = (t.truncate() - n * n.dot(t.truncate())).normalize_or_zero();
+            [t3, t.w * n.cross(t3), n]
+        })
+        .collect();
+    let omegas: Vec<f32> = sphere.solid_angles().iter().map(|&w| w as f32).collect();
+    let start = Instant::now();
+    let transfer = btf::env::EnvTransfer::build(
+        pca.sampling(),
+        &frames,
+        sphere.directions(),
+        &omegas,
+        |i, j| m.is_visible(i, j),
+    );
+    let transfer_ms = start.elapsed().as_secs_f64() * 1e3;
+    let start = Instant::now();
+    let mut w = Vec::new();
+    transfer.update(&radiance, &mut w);
+    let update_w_ms = start.elapsed().as_secs_f64() * 1e3;
+    let mesh = btf_mesh(object, &tangents, uvs);
+    let start = Instant::now();
+    let (image, gamma_ms) = match gpu {
+        Some(g) => {
+            let mut renderer = Renderer::new(&g.device, FrameFormat::single_sample(&g.device));
+            let btf =
+                GpuBtfRenderer::for_frame(&g.device, &g.queue, pca, &renderer.pass_context())?;
+            let t = Instant::now();
+            let draw = btf.prepare_env(&mesh, &w, camera, params)?;
+            let gamma_ms = t.elapsed().as_secs_f64() * 1e3;
+            let background = Background::Color(params.background.to_array());
+            (
+                renderer.render(&g.device, &g.queue, camera, background, &[&draw])?,
+                gamma_ms,
+            )
+        }
+        None => {
+            let image = btf::render::render_cpu_env(pca, &mesh, &w, camera, params)?;
+            (
+                HdrImage::new(camera.width, camera.height, image.to_rgba())?,
+                0.0,
+            )
+        }
+    };
+    let render_ms = start.elapsed().as_secs_f64() * 1e3 - gamma_ms;
+    Ok((
+        image,
+        EnvCost {
+            directions: sphere.len(),
+            vertices: object.positions.len(),
+            visibility_ms,
+            transfer_ms,
+            update_ms: update_w_ms + gamma_ms,
+            render_ms,
+        },
+    ))
+}
+
 /// The seed's display of a BTF render: linear radiance clamped to [0, 1], then sRGB-encoded
 /// (the normtextures are sRGB images, so a unit light shows them as measured); opaque.
 fn display() -> render::tone::Display {
@@ -263,6 +373,19 @@ fn display() -> render::tone::Display {
 /// One image as 8-bit RGBA: clamped, sRGB-encoded (the seed's BTF display), opaque.
 pub fn single(image: &HdrImage) -> image::RgbaImage {
     let rgba = render::output::to_rgba8(image, &display(), Background::Color([0.0; 3]));
+    image::RgbaImage::from_raw(image.width(), image.height(), rgba)
+        .unwrap_or_else(|| image::RgbaImage::new(image.width(), image.height()))
+}
+
+/// One image under an environment as 8-bit RGBA: automatic exposure from the object's pixels
+/// (an HDR map's absolute radiance is arbitrary) and the filmic curve, as scene renders use,
+/// so a sun-lit side keeps its gradation; opaque.
+pub fn single_auto_exposed(image: &HdrImage) -> image::RgbaImage {
+    let display = render::tone::Display {
+        exposure_ev: render::output::auto_exposure(image),
+        curve: render::tone::ToneCurve::AcesFitted,
+    };
+    let rgba = render::output::to_rgba8(image, &display, Background::Color([0.0; 3]));
     image::RgbaImage::from_raw(image.width(), image.height(), rgba)
         .unwrap_or_else(|| image::RgbaImage::new(image.width(), image.height()))
 }

@@ -1,7 +1,7 @@
 //! `cloth-vis btf fins synth | compress` and `btf render --fins` through the binary (thesis
 //! §5.7): the synthetic wool at 32² in the fin folder layout, its PCA (c = 16 by default, exact
 //! with every component), refused input naming the file, and fins that change only the pixels
-//! along the silhouette.
+//! along the silhouette; and `btf render --sky/--env` (§5.5.2).
 
 mod common;
 
@@ -262,4 +262,71 @@ fn fins_change_only_the_pixels_along_the_silhouette() {
         }
     }
     assert!(changed > 100, "only {changed} pixels carry fins");
+}
+
+/// `btf render --sky` / `--env` (thesis §5.5.2): the BTF through the mesh's own visibility
+/// under an environment, with its costs printed; a missing map is named.
+#[test]
+fn render_under_an_environment_prints_its_costs_and_names_a_missing_map() {
+    let tmp = tempfile::tempdir().unwrap();
+    let woven = tmp.path().join("w");
+    let btf_file = tmp.path().join("w.btfpca");
+    let args = [
+        "btf",
+        "synth",
+        "--res",
+        "8",
+        "--out",
+        text(&woven),
+        "--quiet",
+    ];
+    assert!(cli(&args).status.success());
+    let args = [
+        "btf",
+        "compress",
+        text(&woven),
+        "--out",
+        text(&btf_file),
+        "--quiet",
+    ];
+    assert!(cli(&args).status.success());
+    let png = tmp.path().join("sky.png");
+    let out = cli(&[
+        "btf",
+        "render",
+        "synth:sphere",
+        "--btf",
+        text(&btf_file),
+        "--sky",
+        "--level",
+        "2",
+        "--cpu",
+        "--size",
+        "48x48",
+        "--out",
+        text(&png),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = stdout(&out);
+    assert!(line.contains("environment: 66 directions"), "{line}");
+    assert!(line.contains("environment update"), "{line}");
+    let image = image::open(&png).unwrap().to_rgb8();
+    let lit = image.pixels().filter(|p| p.0 != [0, 0, 0]).count();
+    assert!(lit > 300, "the sphere covers only {lit} pixels");
+    let missing = tmp.path().join("nowhere.hdr");
+    let out = cli(&[
+        "btf",
+        "render",
+        "synth:sphere",
+        "--btf",
+        text(&btf_file),
+        "--env",
+        text(&missing),
+        "--cpu",
+        "--out",
+        text(&tmp.path().join("x.png")),
+    ]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("nowhere.hdr"), "{}", stderr(&out));
+    assert!(!tmp.path().join("x.png").exists());
 }

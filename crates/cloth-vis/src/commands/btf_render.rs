@@ -11,12 +11,20 @@ use glam::Vec3;
 use super::invalid as request;
 use cloth_vis::Error;
 /// The light of `btf render`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum RenderLight {
     /// A directional light: world-space direction towards the light.
     Direction(Vec3),
     /// A point light at this world-space position (no distance falloff, eq. 5.4).
     Position(Vec3),
+    /// An environment (already turned onto the mesh's up axis and rotated), through the
+    /// mesh's own visibility at lightsphere `level` (§5.5.2).
+    Environment {
+        /// The map.
+        env: Box<lightsphere::Environment>,
+        /// Lightsphere level of M and of the I_j.
+        level: u32,
+    },
 }
 
 /// What `cloth-vis btf render` was asked to do.
@@ -78,6 +86,8 @@ pub struct RenderSummary {
     pub seconds: f64,
     /// What the fins cost, when drawn.
     pub fins: Option<cloth_vis::btf_stage::FinCost>,
+    /// What the environment light cost, when lit by one.
+    pub env: Option<cloth_vis::btf_stage::EnvCost>,
 }
 
 impl RenderSummary {
@@ -87,6 +97,13 @@ impl RenderSummary {
             "btf render: {} vertices, {} triangles -> {}x{} ({}) in {:.2} s",
             self.mesh.0, self.mesh.1, self.size[0], self.size[1], self.backend, self.seconds
         );
+        if let Some(e) = &self.env {
+            line.push_str(&format!(
+                "; environment: {} directions, visibility {:.0} ms, transfer {:.0} ms, \
+                 environment update {:.1} ms for {} vertices, frame {:.0} ms",
+                e.directions, e.visibility_ms, e.transfer_ms, e.update_ms, e.vertices, e.render_ms
+            ));
+        }
         if let Some(f) = &self.fins {
             line.push_str(&format!(
                 "; fins: {} fins, extraction {:.2} ms, lighting {:.2} ms, frame {:.1} ms with \
@@ -228,18 +245,35 @@ pub fn run_render(
         w,
         h,
     );
-    let light = match request_.light {
+    let mut params = btf::render::RenderParams::default();
+    params.uv_scale = glam::Vec2::splat(request_.uv_scale);
+    let light = match &request_.light {
         RenderLight::Direction(d) => btf::render::Light::Directional {
-            dir_to_light_world: d,
+            dir_to_light_world: *d,
             radiance: request_.radiance,
         },
         RenderLight::Position(p) => btf::render::Light::Point {
-            position_world: p,
+            position_world: *p,
             radiance: request_.radiance,
         },
+        RenderLight::Environment { env, level } => {
+            let start = Instant::now();
+            let (image, cost) = cloth_vis::btf_stage::render_env(
+                gpu, &pca, &object, env, *level, &camera, &params,
+            )?;
+            let picture = cloth_vis::btf_stage::single_auto_exposed(&image);
+            let seconds = start.elapsed().as_secs_f64();
+            figures::strip::write_png(&request_.out, &picture)?;
+            return Ok(RenderSummary {
+                mesh: (object.positions.len(), object.triangles.len()),
+                size: [picture.width(), picture.height()],
+                backend: if gpu.is_some() { "gpu" } else { "cpu" },
+                seconds,
+                fins: None,
+                env: Some(cost),
+            });
+        }
     };
-    let mut params = btf::render::RenderParams::default();
-    params.uv_scale = glam::Vec2::splat(request_.uv_scale);
     let start = Instant::now();
     let objects = [&object];
     if let Some(fins) = &request_.fins {
@@ -269,6 +303,7 @@ pub fn run_render(
             backend: "gpu",
             seconds,
             fins: Some(cost),
+            env: None,
         });
     }
     let image =
@@ -289,6 +324,7 @@ pub fn run_render(
         backend: if gpu.is_some() { "gpu" } else { "cpu" },
         seconds,
         fins: None,
+        env: None,
     })
 }
 
@@ -303,6 +339,24 @@ pub struct RenderArgs {
     /// Directional light: world direction towards it.
     #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, conflicts_with = "light_pos", allow_hyphen_values = true)]
     light_dir: Option<Vec3>,
+    /// Environment light (§5.5.2): an HDR map (.hdr/.exr) through the mesh's own
+    /// self-shadowing (visibility at --level); turned onto --up-axis.
+    #[arg(long, conflicts_with_all = ["light_dir", "light_pos", "sky", "fins", "beside_plain"])]
+    env: Option<PathBuf>,
+    /// Environment light from the procedural sky (see --env).
+    #[arg(long, conflicts_with_all = ["light_dir", "light_pos", "fins", "beside_plain"])]
+    sky: bool,
+    /// Turn the environment by DEG degrees about the up axis.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    env_rotation: f32,
+    /// Lightsphere level of the environment's directions and the visibility (3: 258).
+    #[arg(long, default_value_t = 3)]
+    level: u32,
     /// Point light: world position (no distance falloff).
     #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, allow_hyphen_values = true)]
     light_pos: Option<Vec3>,
@@ -349,12 +403,21 @@ pub struct RenderArgs {
 impl RenderArgs {
     /// Render; the summary line.
     pub(super) fn run(self) -> anyhow::Result<String> {
-        let light = match (self.light_dir, self.light_pos) {
-            (Some(d), _) => RenderLight::Direction(d),
-            (None, Some(p)) => RenderLight::Position(p),
-            (None, None) => {
-                anyhow::bail!("give the light: --light-dir X,Y,Z or --light-pos X,Y,Z")
-            }
+        let env = super::visibility::load_environment(self.env.as_deref(), self.sky)?;
+        let light = match (self.light_dir, self.light_pos, env) {
+            (Some(d), _, _) => RenderLight::Direction(d),
+            (None, Some(p), _) => RenderLight::Position(p),
+            (None, None, Some(env)) => RenderLight::Environment {
+                env: Box::new(super::visibility::turned_environment(
+                    env,
+                    self.up_axis,
+                    self.env_rotation,
+                )),
+                level: self.level,
+            },
+            (None, None, None) => anyhow::bail!(
+                "give the light: --light-dir X,Y,Z, --light-pos X,Y,Z, --env FILE.hdr or --sky"
+            ),
         };
         let gpu = if self.cpu {
             None
