@@ -381,8 +381,13 @@ pub fn single(image: &HdrImage) -> image::RgbaImage {
 /// (an HDR map's absolute radiance is arbitrary) and the filmic curve, as scene renders use,
 /// so a sun-lit side keeps its gradation; opaque.
 pub fn single_auto_exposed(image: &HdrImage) -> image::RgbaImage {
+    single_exposed(image, render::output::auto_exposure(image))
+}
+
+/// As [`single_auto_exposed`] with a given exposure (EV), so a sequence keeps one exposure.
+pub fn single_exposed(image: &HdrImage, exposure_ev: f32) -> image::RgbaImage {
     let display = render::tone::Display {
-        exposure_ev: render::output::auto_exposure(image),
+        exposure_ev,
         curve: render::tone::ToneCurve::AcesFitted,
     };
     let rgba = render::output::to_rgba8(image, &display, Background::Color([0.0; 3]));

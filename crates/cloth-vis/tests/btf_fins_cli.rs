@@ -329,4 +329,72 @@ fn render_under_an_environment_prints_its_costs_and_names_a_missing_map() {
     assert!(!out.status.success());
     assert!(stderr(&out).contains("nowhere.hdr"), "{}", stderr(&out));
     assert!(!tmp.path().join("x.png").exists());
+
+    // The deforming drape, frame by frame, each with its own visibility.
+    let dir = tmp.path().join("frames");
+    let args = [
+        "btf",
+        "render",
+        "synth:cloth",
+        "--btf",
+        text(&btf_file),
+        "--sky",
+        "--level",
+        "1",
+        "--frames",
+        "118..120",
+        "--cpu",
+        "--size",
+        "32x32",
+        "--quiet",
+        "--out",
+        text(&dir),
+    ];
+    let out = cli(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["frame-0118.png", "frame-0119.png"]);
+    // Outside the drape's 120 frames, or a mesh that does not move: refused, nothing written.
+    let bad = tmp.path().join("bad");
+    let out = cli(&[
+        "btf",
+        "render",
+        "synth:cloth",
+        "--btf",
+        text(&btf_file),
+        "--sky",
+        "--frames",
+        "100..130",
+        "--cpu",
+        "--out",
+        text(&bad),
+    ]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("100..130"),
+        "{}",
+        stderr(&out)
+    );
+    let out = cli(&[
+        "btf",
+        "render",
+        "synth:sphere",
+        "--btf",
+        text(&btf_file),
+        "--sky",
+        "--frames",
+        "0..2",
+        "--cpu",
+        "--out",
+        text(&bad),
+    ]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("animated"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!bad.exists());
 }

@@ -56,8 +56,13 @@ pub struct RenderRequest {
     /// Fins (§5.7): a `.finpca` file or `synth:wool`, with height (material units) and size
     /// (world length of a material unit; default a fraction of the mesh's radius).
     pub fins: Option<FinsRequest>,
-    /// The PNG to write.
+    /// Frames A..B of an animated input (`synth:cloth`): `out` is then a folder of
+    /// frame-NNNN.png, each lit with that frame's own visibility.
+    pub frames: Option<(usize, usize)>,
+    /// The PNG to write (a folder with `frames`).
     pub out: PathBuf,
+    /// Show a progress bar over frames.
+    pub progress: bool,
 }
 
 /// The fins of `btf render`.
@@ -188,7 +193,7 @@ pub fn run_render(
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    if !png {
+    if !png && request_.frames.is_none() {
         return Err(request(
             &request_.out,
             "the image is written as .png".to_owned(),
@@ -225,38 +230,20 @@ pub fn run_render(
         }
     };
     let pca = BtfPca::read(&request_.btf)?;
+    if let Some(frames) = request_.frames {
+        return run_frames(request_, gpu, &pca, frames);
+    }
     let object = render_mesh(&request_.mesh)?;
     let (centre, radius) =
         render::bounding_sphere(object.positions.iter()).unwrap_or((Vec3::ZERO, 1.0));
-    let up = super::up_axis::up_axis_rotation(request_.up_axis).as_quat();
-    let desc = cloth_vis::scene::CameraDesc {
-        width: w,
-        height: h,
-        direction: (up * request_.camera_direction).to_array(),
-        up: (up * Vec3::Y).to_array(),
-        ..cloth_vis::scene::CameraDesc::default()
-    };
-    let framed = cloth_vis::camera::resolve(&desc, centre, radius);
-    let camera = render::Camera::look_at(
-        framed.eye,
-        framed.target,
-        Vec3::from(desc.up),
-        desc.fov_deg,
-        w,
-        h,
-    );
+    let camera = framing_camera(request_, centre, radius);
     let mut params = btf::render::RenderParams::default();
     params.uv_scale = glam::Vec2::splat(request_.uv_scale);
-    let light = match &request_.light {
-        RenderLight::Direction(d) => btf::render::Light::Directional {
-            dir_to_light_world: *d,
-            radiance: request_.radiance,
-        },
-        RenderLight::Position(p) => btf::render::Light::Point {
-            position_world: *p,
-            radiance: request_.radiance,
-        },
-        RenderLight::Environment { env, level } => {
+    let Some(light) = one_light(&request_.light, request_.radiance) else {
+        let RenderLight::Environment { env, level } = &request_.light else {
+            return Err(request(&request_.out, "no light to render with".to_owned()));
+        };
+        {
             let start = Instant::now();
             let (image, cost) = cloth_vis::btf_stage::render_env(
                 gpu, &pca, &object, env, *level, &camera, &params,
@@ -328,6 +315,160 @@ pub fn run_render(
     })
 }
 
+/// The point or directional light of `light` (`None` for an environment).
+fn one_light(light: &RenderLight, radiance: Vec3) -> Option<btf::render::Light> {
+    match *light {
+        RenderLight::Direction(d) => Some(btf::render::Light::Directional {
+            dir_to_light_world: d,
+            radiance,
+        }),
+        RenderLight::Position(p) => Some(btf::render::Light::Point {
+            position_world: p,
+            radiance,
+        }),
+        RenderLight::Environment { .. } => None,
+    }
+}
+
+/// The camera of `btf render`: framing the sphere (`centre`, `radius`) from `--camera-dir`,
+/// turned onto `--up-axis`.
+fn framing_camera(request_: &RenderRequest, centre: Vec3, radius: f32) -> render::Camera {
+    let [w, h] = request_.size;
+    let up = super::up_axis::up_axis_rotation(request_.up_axis).as_quat();
+    let desc = cloth_vis::scene::CameraDesc {
+        width: w,
+        height: h,
+        direction: (up * request_.camera_direction).to_array(),
+        up: (up * Vec3::Y).to_array(),
+        ..cloth_vis::scene::CameraDesc::default()
+    };
+    let framed = cloth_vis::camera::resolve(&desc, centre, radius);
+    render::Camera::look_at(
+        framed.eye,
+        framed.target,
+        Vec3::from(desc.up),
+        desc.fov_deg,
+        w,
+        h,
+    )
+}
+
+/// `btf render --frames A..B`: the deforming drape frame by frame, each frame's visibility,
+/// transfer and γ* recomputed (the thesis could light only static meshes by an environment;
+/// §5.5.2), one camera framing all frames, written as a folder that appears complete or not
+/// at all.
+fn run_frames(
+    request_: &RenderRequest,
+    gpu: Option<&gpu_context::GpuContext>,
+    pca: &BtfPca,
+    (start, end): (usize, usize),
+) -> Result<RenderSummary, Error> {
+    if request_.mesh != Path::new("synth:cloth") {
+        return Err(request(
+            &request_.mesh,
+            "--frames needs an animated input; the one built in is synth:cloth".to_owned(),
+        ));
+    }
+    let anim = synth::simulate_cloth(&synth::ClothParams::default())?;
+    let total = anim.frames.len();
+    if start >= end || end > total {
+        return Err(request(
+            &request_.out,
+            format!("--frames {start}..{end} is outside the drape's {total} frames (0..{total})"),
+        ));
+    }
+    let existing = super::folder_output(&request_.out, false)?;
+    let (centre, radius) = render::bounding_sphere(anim.frames[start..end].iter().flatten())
+        .unwrap_or((Vec3::ZERO, 1.0));
+    let camera = framing_camera(request_, centre, radius);
+    let mut params = btf::render::RenderParams::default();
+    params.uv_scale = glam::Vec2::splat(request_.uv_scale);
+    let bar = cloth_vis::run::progress_bar(request_.progress, (end - start) as u64, "frames");
+    let begin = Instant::now();
+    let mut sum: Option<cloth_vis::btf_stage::EnvCost> = None;
+    let mut exposure: Option<f32> = None;
+    let mut size = [0, 0];
+    atomic_out::write_dir(&request_.out, existing, |dir| {
+        for f in start..end {
+            let positions = anim.frames[f].clone();
+            let normals = meshio::compute_normals(
+                &positions,
+                &anim.triangles,
+                meshio::NormalWeighting::Angle,
+            );
+            let object = cloth_vis::object::WorldObject {
+                name: format!("synth:cloth frame {f}"),
+                positions,
+                normals,
+                triangles: anim.triangles.clone(),
+                uvs: Some(anim.uvs.clone()),
+                albedo: Vec3::ONE,
+                two_sided: true,
+                front: None,
+                back: None,
+                animation: None,
+            };
+            let picture = match (
+                &request_.light,
+                one_light(&request_.light, request_.radiance),
+            ) {
+                (RenderLight::Environment { env, level }, _) => {
+                    let (image, cost) = cloth_vis::btf_stage::render_env(
+                        gpu, pca, &object, env, *level, &camera, &params,
+                    )?;
+                    sum = Some(match sum {
+                        None => cost,
+                        Some(s) => cloth_vis::btf_stage::EnvCost {
+                            visibility_ms: s.visibility_ms + cost.visibility_ms,
+                            transfer_ms: s.transfer_ms + cost.transfer_ms,
+                            update_ms: s.update_ms + cost.update_ms,
+                            render_ms: s.render_ms + cost.render_ms,
+                            ..s
+                        },
+                    });
+                    // One exposure for the sequence (the first frame's), so it does not flicker.
+                    let ev = *exposure.get_or_insert_with(|| render::output::auto_exposure(&image));
+                    cloth_vis::btf_stage::single_exposed(&image, ev)
+                }
+                (_, Some(light)) => {
+                    let image = cloth_vis::btf_stage::render_objects(
+                        gpu,
+                        pca,
+                        &[&object],
+                        &light,
+                        &camera,
+                        &params,
+                    )?;
+                    cloth_vis::btf_stage::single(&image)
+                }
+                (_, None) => {
+                    return Err(request(&request_.out, "no light to render with".to_owned()));
+                }
+            };
+            size = [picture.width(), picture.height()];
+            figures::strip::write_png(&dir.join(format!("frame-{f:04}.png")), &picture)?;
+            bar.inc(1);
+        }
+        Ok::<(), Error>(())
+    })?;
+    bar.finish_and_clear();
+    let n = (end - start) as f64;
+    Ok(RenderSummary {
+        mesh: (anim.vertex_count(), anim.triangles.len()),
+        size,
+        backend: if gpu.is_some() { "gpu" } else { "cpu" },
+        seconds: begin.elapsed().as_secs_f64(),
+        fins: None,
+        env: sum.map(|s| cloth_vis::btf_stage::EnvCost {
+            visibility_ms: s.visibility_ms / n,
+            transfer_ms: s.transfer_ms / n,
+            update_ms: s.update_ms / n,
+            render_ms: s.render_ms / n,
+            ..s
+        }),
+    })
+}
+
 /// `cloth-vis btf render`.
 #[derive(clap::Args)]
 pub struct RenderArgs {
@@ -395,7 +536,14 @@ pub struct RenderArgs {
     /// Draw the mesh without fins on the left, with fins on the right (Figs. 5.23/5.24).
     #[arg(long, requires = "fins")]
     beside_no_fins: bool,
-    /// Output: IMAGE.png.
+    /// Frames A..B of synth:cloth, each lit with its own visibility; --out is then a new
+    /// folder of frame-NNNN.png.
+    #[arg(long, value_name = "A..B", value_parser = super::parse::range, conflicts_with_all = ["fins", "beside_plain"])]
+    frames: Option<(usize, usize)>,
+    /// Hide the progress bar over frames.
+    #[arg(long)]
+    quiet: bool,
+    /// Output: IMAGE.png (a folder with --frames).
     #[arg(long)]
     out: PathBuf,
 }
@@ -441,7 +589,9 @@ impl RenderArgs {
                 size: self.fin_size,
                 beside_without: self.beside_no_fins,
             }),
+            frames: self.frames,
             out: self.out,
+            progress: !self.quiet,
         };
         Ok(run_render(&request, gpu.as_ref())?.line())
     }
