@@ -47,6 +47,7 @@ mod compare_translucency;
 mod python;
 mod repro_anim_compression;
 mod repro_btf;
+mod repro_btf_env;
 mod repro_fins;
 mod repro_hemicube;
 mod repro_jumpmap;
@@ -161,6 +162,9 @@ enum Repro {
         #[arg(long)]
         quick: bool,
     },
+    /// BTF under a point light and an HDR map (§5.5.2, Table 5.2): HEM update and frame
+    /// times on the dress and two drapes beside the seed's rows.
+    BtfEnv,
     /// BTF fins (§5.7): the wool's PCA against c, fin extraction per frame on the drape,
     /// Figs. 5.23/5.24 with and without fins and the fins' share of the frame.
     Fins,
@@ -219,6 +223,9 @@ fn main() -> anyhow::Result<()> {
             what: Repro::Hemicube { quick },
         } => repro_hemicube::run(&repro_dir()?, quick),
         Command::Repro { what: Repro::Fins } => repro_fins::run(&repro_dir()?),
+        Command::Repro {
+            what: Repro::BtfEnv,
+        } => repro_btf_env::run(&repro_dir()?),
         Command::Repro {
             what: Repro::Shadows { quick },
         } => repro_shadows::run(&repro_dir()?, quick),

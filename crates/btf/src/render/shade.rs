@@ -3,6 +3,7 @@
 //! per slot the light's γ_kj (eq. 5.3).
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::mesh::{BtfMesh, Frame, Light};
 use crate::env::EnvLightWeights;
@@ -86,24 +87,31 @@ impl VertexShading {
             gammas: vec![0.0; n * 4 * gamma_stride],
         };
         let sampling = pca.sampling();
-        let mut scratch = vec![Vec3::ZERO; coefficients];
-        let per_vertex = out.gammas.chunks_exact_mut(4 * gamma_stride);
-        for (v, gammas) in per_vertex.enumerate() {
-            let view_in_tangent = frames[v].in_frame(eye_world - mesh.positions[v]);
-            let omega = sampling.view_weights(view_in_tangent);
-            for (m, g) in gammas.chunks_exact_mut(gamma_stride).enumerate() {
-                let j = omega.indices[m];
-                out.slots[v][m] = j as u32;
-                out.omega[v][m] = omega.weights[m];
-                if omega.weights[m] != 0.0 {
-                    let len = pca.gamma_len(j);
-                    pca.env_gamma(j, &w[v], &mut scratch[..len]);
-                    for (k, c) in scratch[..len].iter().enumerate() {
-                        g[3 * k..3 * k + 3].copy_from_slice(&c.to_array());
+        // Parallel over vertices: γ* is an 81 × (c + 1) product per slot, the bulk of an
+        // environment update.
+        out.gammas
+            .par_chunks_exact_mut(4 * gamma_stride)
+            .zip(out.slots.par_iter_mut())
+            .zip(out.omega.par_iter_mut())
+            .enumerate()
+            .for_each(|(v, ((gammas, slots), omegas))| {
+                let mut scratch = [Vec3::ZERO; crate::MAX_GAMMAS];
+                let view_in_tangent = frames[v].in_frame(eye_world - mesh.positions[v]);
+                let omega = sampling.view_weights(view_in_tangent);
+                for (m, g) in gammas.chunks_exact_mut(gamma_stride).enumerate() {
+                    let j = omega.indices[m];
+                    slots[m] = j as u32;
+                    omegas[m] = omega.weights[m];
+                    if omega.weights[m] != 0.0 {
+                        let len = pca.gamma_len(j);
+                        pca.env_gamma(j, &w[v], &mut scratch[..len]);
+                        for (k, c) in scratch[..len].iter().enumerate() {
+                            g[3 * k..3 * k + 3].copy_from_slice(&c.to_array());
+                        }
                     }
                 }
-            }
-        }
+            });
+        debug_assert!(coefficients <= crate::MAX_GAMMAS);
         out
     }
 
