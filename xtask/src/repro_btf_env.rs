@@ -40,28 +40,13 @@ fn cloth(grid: usize, name: &str) -> anyhow::Result<WorldObject> {
     let positions = anim.frames[last].clone();
     let normals =
         meshio::compute_normals(&positions, &anim.triangles, meshio::NormalWeighting::Angle);
-    Ok(object(name, positions, normals, anim.triangles, anim.uvs))
-}
-
-fn object(
-    name: &str,
-    positions: Vec<Vec3>,
-    normals: Vec<Vec3>,
-    triangles: Vec<[u32; 3]>,
-    uvs: Vec<Vec2>,
-) -> WorldObject {
-    WorldObject {
-        name: name.to_owned(),
+    Ok(WorldObject::textured(
+        name,
         positions,
         normals,
-        triangles,
-        uvs: Some(uvs),
-        albedo: Vec3::ONE,
-        two_sided: true,
-        front: None,
-        back: None,
-        animation: None,
-    }
+        anim.triangles,
+        Some(anim.uvs),
+    ))
 }
 
 /// Runs the reproduction and writes `btf-env.md` under `out`.
@@ -97,7 +82,13 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
             let uvs = m
                 .uvs
                 .ok_or_else(|| anyhow::anyhow!("the dress has no UVs"))?;
-            let dress = object("the draped dress", m.positions, m.normals, m.triangles, uvs);
+            let dress = WorldObject::textured(
+                "the draped dress",
+                m.positions,
+                m.normals,
+                m.triangles,
+                Some(uvs),
+            );
             meshes.push((dress, Vec3::Z));
         }
         None => eprintln!("the shared dress is absent: the table has the drapes only"),

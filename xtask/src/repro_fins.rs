@@ -145,18 +145,7 @@ fn object(
     uvs: Vec<Vec2>,
 ) -> WorldObject {
     let normals = meshio::compute_normals(&positions, &triangles, meshio::NormalWeighting::Angle);
-    WorldObject {
-        name: name.to_owned(),
-        positions,
-        normals,
-        triangles,
-        uvs: Some(uvs),
-        albedo: Vec3::ONE,
-        two_sided: true,
-        front: None,
-        back: None,
-        animation: None,
-    }
+    WorldObject::textured(name, positions, normals, triangles, Some(uvs))
 }
 
 /// Figs. 5.23 and 5.24 with the woven BTF of `synth` (32², c = 16) on the surface.

@@ -5,44 +5,12 @@
 //! 10⁴ times the sky.
 
 use btf::env::EnvLightWeights;
-use btf::{BtfPca, BtfPcaParams, DIRECTIONS, Sampling, Storage, ViewSlot};
+use btf::{DIRECTIONS, Sampling};
 use glam::Vec3;
 
-const RES: usize = 8;
-const A: Vec3 = Vec3::new(0.8, 0.5, 0.3);
-const B: Vec3 = Vec3::new(0.2, 0.6, 0.9);
-
-fn lambertian(sampling: Sampling) -> (BtfPca, synth::LambertianBtf) {
-    let lam = synth::LambertianBtf::new(RES, A, B).unwrap();
-    let load = |j| {
-        let data = (0..DIRECTIONS)
-            .flat_map(|i| lam.image(sampling.vector(i)))
-            .flatten()
-            .collect();
-        ViewSlot::new(j, RES, RES, data)
-    };
-    let params = BtfPcaParams {
-        storage: Storage::F32,
-        mean_storage: Storage::F32,
-        ..Default::default()
-    };
-    let (pca, _) = BtfPca::compress_with(sampling, RES, RES, &params, load, None).unwrap();
-    (pca, lam)
-}
-
-/// `n` directions of a Fibonacci sphere, each with solid angle 4π/n.
-fn sphere_directions(n: usize) -> (Vec<Vec3>, f32) {
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    let dirs = (0..n)
-        .map(|i| {
-            let z = 1.0 - (2.0 * i as f64 + 1.0) / n as f64;
-            let r = (1.0 - z * z).sqrt();
-            let phi = golden * i as f64;
-            Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32)
-        })
-        .collect();
-    (dirs, (4.0 * std::f64::consts::PI / n as f64) as f32)
-}
+#[path = "common/env.rs"]
+mod env_common;
+use env_common::{RES, lambertian, sphere_directions};
 
 fn random_frame(next: &mut impl FnMut() -> f32) -> [Vec3; 3] {
     let n = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();

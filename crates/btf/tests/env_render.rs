@@ -2,14 +2,15 @@
 //! under a uniform sky with nothing in the way is ρ L at every pixel (the closed form), on
 //! the CPU reference and on the GPU, and the GPU matches the CPU.
 
+use btf::Sampling;
 use btf::env::EnvTransfer;
 use btf::render::{BtfMesh, Camera, RenderParams, render_cpu_env, tangent_frames};
-use btf::{BtfPca, BtfPcaParams, DIRECTIONS, Sampling, Storage, ViewSlot};
 use glam::{Vec2, Vec3};
 
-const RES: usize = 8;
-const A: Vec3 = Vec3::new(0.8, 0.5, 0.3);
-const B: Vec3 = Vec3::new(0.2, 0.6, 0.9);
+#[path = "common/env.rs"]
+mod env_common;
+use env_common::{A, B, lambertian, sphere_directions};
+
 const SKY: Vec3 = Vec3::new(1.0, 0.8, 0.6);
 
 struct Sphere {
@@ -54,46 +55,9 @@ fn sphere(rings: u32, segments: u32) -> Sphere {
     }
 }
 
-fn lambertian() -> BtfPca {
-    let s = Sampling::H1;
-    let lam = synth::LambertianBtf::new(RES, A, B).unwrap();
-    let load = |j| {
-        let data = (0..DIRECTIONS)
-            .flat_map(|i| lam.image(s.vector(i)))
-            .flatten()
-            .collect();
-        ViewSlot::new(j, RES, RES, data)
-    };
-    let params = BtfPcaParams {
-        storage: Storage::F32,
-        mean_storage: Storage::F32,
-        ..Default::default()
-    };
-    BtfPca::compress_with(s, RES, RES, &params, load, None)
-        .unwrap()
-        .0
-}
-
-/// Fibonacci directions with equal solid angles.
-fn directions(n: usize) -> (Vec<Vec3>, Vec<f32>) {
-    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    let dirs = (0..n)
-        .map(|i| {
-            let z = 1.0 - (2.0 * i as f32 + 1.0) / n as f32;
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            Vec3::new(
-                r * (golden * i as f32).cos(),
-                r * (golden * i as f32).sin(),
-                z,
-            )
-        })
-        .collect();
-    (dirs, vec![4.0 * std::f32::consts::PI / n as f32; n])
-}
-
 #[test]
 fn a_lambertian_sphere_under_a_uniform_sky_is_rho_l_at_every_pixel() {
-    let pca = lambertian();
+    let (pca, _) = lambertian(Sampling::H1);
     let sph = sphere(24, 48);
     let normals = sph.positions.clone();
     let tangents = tangent_frames(&sph.positions, &normals, &sph.uvs, &sph.triangles).unwrap();
@@ -112,7 +76,8 @@ fn a_lambertian_sphere_under_a_uniform_sky_is_rho_l_at_every_pixel() {
             [t3, t.w * n.cross(t3), *n]
         })
         .collect();
-    let (dirs, omegas) = directions(6000);
+    let (dirs, omega) = sphere_directions(6000);
+    let omegas = vec![omega; dirs.len()];
     // Nothing occludes a convex sphere: every direction above the horizon is visible.
     let transfer = EnvTransfer::build(Sampling::H1, &frames, &dirs, &omegas, |_, _| true);
     let mut w = Vec::new();

@@ -31,6 +31,31 @@ pub struct WorldObject {
     pub animation: Option<Animation>,
 }
 
+impl WorldObject {
+    /// A static, white, two-sided object with texture coordinates (what a BTF is drawn on),
+    /// not yet lit.
+    pub fn textured(
+        name: impl Into<String>,
+        positions: Vec<Vec3>,
+        normals: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+        uvs: Option<Vec<Vec2>>,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            positions,
+            normals,
+            triangles,
+            uvs,
+            albedo: Vec3::ONE,
+            two_sided: true,
+            front: None,
+            back: None,
+            animation: None,
+        }
+    }
+}
+
 /// The frames of an animated object, in object space.
 #[derive(Clone, Debug)]
 pub struct Animation {

@@ -34,6 +34,31 @@ fn synth(dir: &Path) -> Output {
     ])
 }
 
+/// The synthetic woven BTF at `res`², compressed: `DIR/w.btfpca`.
+fn woven_btf(dir: &Path, res: &str) -> std::path::PathBuf {
+    let (woven, file) = (dir.join("w"), dir.join("w.btfpca"));
+    let args = [
+        "btf",
+        "synth",
+        "--res",
+        res,
+        "--out",
+        text(&woven),
+        "--quiet",
+    ];
+    assert!(cli(&args).status.success());
+    let args = [
+        "btf",
+        "compress",
+        text(&woven),
+        "--out",
+        text(&file),
+        "--quiet",
+    ];
+    assert!(cli(&args).status.success());
+    file
+}
+
 #[test]
 fn synth_then_compress_keeps_16_components_and_all_80_reconstruct_exactly() {
     let tmp = tempfile::tempdir().unwrap();
@@ -186,27 +211,7 @@ fn fins_change_only_the_pixels_along_the_silhouette() {
         return;
     }
     let tmp = tempfile::tempdir().unwrap();
-    let woven = tmp.path().join("w");
-    let btf_file = tmp.path().join("w.btfpca");
-    let args = [
-        "btf",
-        "synth",
-        "--res",
-        "16",
-        "--out",
-        text(&woven),
-        "--quiet",
-    ];
-    assert!(cli(&args).status.success());
-    let args = [
-        "btf",
-        "compress",
-        text(&woven),
-        "--out",
-        text(&btf_file),
-        "--quiet",
-    ];
-    assert!(cli(&args).status.success());
+    let btf_file = woven_btf(tmp.path(), "16");
     let render = |extra: &[&str], out: &Path| {
         let mut args = vec![
             "btf",
@@ -269,27 +274,7 @@ fn fins_change_only_the_pixels_along_the_silhouette() {
 #[test]
 fn render_under_an_environment_prints_its_costs_and_names_a_missing_map() {
     let tmp = tempfile::tempdir().unwrap();
-    let woven = tmp.path().join("w");
-    let btf_file = tmp.path().join("w.btfpca");
-    let args = [
-        "btf",
-        "synth",
-        "--res",
-        "8",
-        "--out",
-        text(&woven),
-        "--quiet",
-    ];
-    assert!(cli(&args).status.success());
-    let args = [
-        "btf",
-        "compress",
-        text(&woven),
-        "--out",
-        text(&btf_file),
-        "--quiet",
-    ];
-    assert!(cli(&args).status.success());
+    let btf_file = woven_btf(tmp.path(), "8");
     let png = tmp.path().join("sky.png");
     let out = cli(&[
         "btf",

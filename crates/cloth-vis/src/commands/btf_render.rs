@@ -163,18 +163,13 @@ fn render_mesh(path: &Path) -> Result<cloth_vis::object::WorldObject, Error> {
                 .to_owned(),
         ));
     }
-    Ok(cloth_vis::object::WorldObject {
-        name: path.display().to_string(),
+    Ok(cloth_vis::object::WorldObject::textured(
+        path.display().to_string(),
         positions,
         normals,
         triangles,
         uvs,
-        albedo: Vec3::ONE,
-        two_sided: true,
-        front: None,
-        back: None,
-        animation: None,
-    })
+    ))
 }
 
 /// Runs `btf render`: the mesh textured by the compressed BTF under one light (thesis §5.5),
@@ -396,18 +391,13 @@ fn run_frames(
                 &anim.triangles,
                 meshio::NormalWeighting::Angle,
             );
-            let object = cloth_vis::object::WorldObject {
-                name: format!("synth:cloth frame {f}"),
+            let object = cloth_vis::object::WorldObject::textured(
+                format!("synth:cloth frame {f}"),
                 positions,
                 normals,
-                triangles: anim.triangles.clone(),
-                uvs: Some(anim.uvs.clone()),
-                albedo: Vec3::ONE,
-                two_sided: true,
-                front: None,
-                back: None,
-                animation: None,
-            };
+                anim.triangles.clone(),
+                Some(anim.uvs.clone()),
+            );
             let picture = match (
                 &request_.light,
                 one_light(&request_.light, request_.radiance),
