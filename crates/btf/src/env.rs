@@ -109,7 +109,8 @@ impl EnvLightWeights {
         }
     }
 
-    /// Σ_m W(m): what a white Lambertian BTF (images cos θ) would reflect, per unit albedo.
+    /// Σ_m W(m) = Σ_d V(d) L(d) ω_d / π over the visible directions above the horizon (the
+    /// τ of each sum to 1): γ*_0, the weight of the mean image in every view slot.
     pub fn total(&self) -> Vec3 {
         self.weights.iter().sum()
     }
