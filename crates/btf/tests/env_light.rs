@@ -10,25 +10,7 @@ use glam::Vec3;
 
 #[path = "common/env.rs"]
 mod env_common;
-use env_common::{RES, lambertian, sphere_directions};
-
-fn random_frame(next: &mut impl FnMut() -> f32) -> [Vec3; 3] {
-    let n = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
-    let t0 = n.any_orthonormal_vector();
-    let angle = std::f32::consts::TAU * next();
-    let t = t0 * angle.cos() + n.cross(t0) * angle.sin();
-    [t, n.cross(t), n]
-}
-
-fn rng(seed: u64) -> impl FnMut() -> f32 {
-    let mut s = seed;
-    move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+use env_common::{RES, lambertian, random_frame, rng, sphere_directions};
 
 fn assert_rel(got: [f32; 3], want: Vec3, tol: f32, what: &str) {
     for (g, w) in got.iter().zip(want.to_array()) {

@@ -42,3 +42,23 @@ pub fn sphere_directions(n: usize) -> (Vec<Vec3>, f32) {
         .collect();
     (dirs, (4.0 * std::f64::consts::PI / n as f64) as f32)
 }
+
+/// A random orthonormal (tangent, bitangent, normal).
+pub fn random_frame(next: &mut impl FnMut() -> f32) -> [Vec3; 3] {
+    let n = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
+    let t0 = n.any_orthonormal_vector();
+    let angle = std::f32::consts::TAU * next();
+    let t = t0 * angle.cos() + n.cross(t0) * angle.sin();
+    [t, n.cross(t), n]
+}
+
+/// A seeded LCG giving floats in [0, 1).
+pub fn rng(seed: u64) -> impl FnMut() -> f32 {
+    let mut s = seed;
+    move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    }
+}

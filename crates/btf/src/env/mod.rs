@@ -51,6 +51,9 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+mod decompose;
+pub use decompose::{EnvDecomposition, relative_error};
+
 use crate::model::BtfPca;
 use crate::sampling::{DIRECTIONS, Sampling};
 
