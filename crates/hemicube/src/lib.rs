@@ -21,7 +21,9 @@
 //! * [`lighting`]: environment radiance through a power-conserving cube map (the seed's) or
 //!   exact per-pixel look-ups, rotation without rebuilding maps, point lights by map or by ray.
 //! * [`MeasuredChannel`]: per pixel the four nearest of the 81 measured BTF directions and
-//!   their bilinear weights (§5.5.2, Fig. 5.12), for BTF rendering under environment light.
+//!   their bilinear weights (§5.5.2, Fig. 5.12); [`BtfLightChannel`] the light side of it, which
+//!   bins an environment onto a BTF's 81 light directions per vertex (eq. 5.10) for BTF
+//!   rendering under environment light (`btf::env`).
 //!
 //! # Example
 //! ```
@@ -61,5 +63,8 @@ pub use layout::{
 };
 pub use lighting::{CubeMap, EnvLookup, PointLight, PointLighting, PointVisibility};
 pub use maps::{VertexFrame, VisibilityMaps};
-pub use measured::MeasuredChannel;
-pub use rays::{BuildParams, BuildStats, build_with_caster, build_with_progress, build_with_rays};
+pub use measured::{BtfLightChannel, MeasuredChannel};
+pub use rays::{
+    BuildParams, BuildStats, build_with_caster, build_with_frames, build_with_progress,
+    build_with_rays,
+};

@@ -10,6 +10,7 @@
 //! pixel: the cosine and solid-angle weighting stays in ΔF, and the BTF's own horizon fade is the
 //! renderer's business.
 
+use btf::env::EnvLightWeights;
 use btf::sampling::{DIRECTIONS, Sampling, Weights4};
 use glam::{DVec3, Mat3, Vec3};
 use rayon::prelude::*;
@@ -73,5 +74,92 @@ impl MeasuredChannel {
             })
             .collect();
         rows.concat()
+    }
+}
+
+/// The light side of the channel for BTF rendering under environment light (thesis §5.5.2,
+/// eq. 5.10 with the pixel's solid angle): per pixel, the four nearest measured **light**
+/// directions and τ_m(d_p) · Δω_p / π (`btf::Sampling::light_weights`, with the horizon fade;
+/// the cosine is in the BTF images, so the weight is the solid angle, not ΔF).
+///
+/// It assumes maps built in each vertex's texture tangent frame
+/// ([`crate::build_with_frames`] with [`crate::VertexFrame::from_normal_tangent`]), so a pixel
+/// has the same tangent-frame direction at every vertex; a vertex whose UVs are mirrored has
+/// its bitangent flipped, and uses the mirrored table.
+#[derive(Clone, Debug)]
+pub struct BtfLightChannel {
+    sampling: Sampling,
+    /// Per pixel (right-handed tangent frame, mirrored), the (m, τ_m Δω / π) entries.
+    weights: [Vec<Weights4>; 2],
+}
+
+impl BtfLightChannel {
+    /// The channel of `layout` for `sampling`.
+    pub fn new(layout: &PixelLayout, sampling: Sampling) -> Self {
+        let table = |flip: f32| {
+            layout
+                .directions()
+                .iter()
+                .zip(layout.solid_angles())
+                .map(|(d, &omega)| {
+                    let mut w = sampling.light_weights(Vec3::new(d.x, flip * d.y, d.z));
+                    w.weights
+                        .iter_mut()
+                        .for_each(|x| *x *= omega * std::f32::consts::FRAC_1_PI);
+                    w
+                })
+                .collect()
+        };
+        Self {
+            sampling,
+            weights: [table(1.0), table(-1.0)],
+        }
+    }
+
+    /// The sampling.
+    pub fn sampling(&self) -> Sampling {
+        self.sampling
+    }
+
+    /// W_i(m) = Σ_p V_p τ_m(d_p) L(R_i d_p) Δω_p / π of every vertex (the environment binned
+    /// onto the BTF's measured light directions, `btf::env`), `radiance` the world radiance
+    /// and `mirrored[i]` whether vertex i's bitangent is n × t negated. A vertex without a
+    /// frame gets all zeros. Parallel over vertices.
+    ///
+    /// # Panics
+    /// If `mirrored` has not one entry per map.
+    pub fn light_weights<F>(
+        &self,
+        maps: &VisibilityMaps,
+        mirrored: &[bool],
+        radiance: F,
+    ) -> Vec<EnvLightWeights>
+    where
+        F: Fn(Vec3) -> Vec3 + Sync,
+    {
+        assert_eq!(mirrored.len(), maps.len(), "one handedness per map");
+        let dirs = maps.layout().directions();
+        (0..maps.len())
+            .into_par_iter()
+            .map(|i| {
+                let mut w = EnvLightWeights::default();
+                let Some(frame) = maps.frame(i) else {
+                    return w;
+                };
+                let table = &self.weights[usize::from(mirrored[i])];
+                let m = Mat3::from_quat(frame.rotation);
+                let mut acc = [DVec3::ZERO; DIRECTIONS];
+                for p in maps.open_pixels(i) {
+                    let l = radiance(m * dirs[p]).as_dvec3();
+                    for (index, tau) in table[p].iter() {
+                        acc[index] += f64::from(tau) * l;
+                    }
+                }
+                for (o, a) in w.weights.iter_mut().zip(acc) {
+                    *o = a.as_vec3();
+                }
+                w
+            })
+            .collect()
     }
 }

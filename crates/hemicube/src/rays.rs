@@ -127,7 +127,27 @@ pub fn build_with_progress(
     params: &BuildParams,
     progress: &(dyn Fn(u64) + Sync),
 ) -> (VisibilityMaps, BuildStats) {
-    let frames = frames_of(caster);
+    build_with_frames(caster, layout, params, frames_of(caster), progress)
+}
+
+/// [`build_with_progress`] with each receiver's map frame given (`None`: no map), e.g.
+/// [`VertexFrame::from_normal_tangent`] so that a map pixel's direction is the same in every
+/// vertex's texture tangent frame (BTF rendering, [`crate::BtfLightChannel`]).
+///
+/// # Panics
+/// If `frames` has not one entry per receiver vertex.
+pub fn build_with_frames(
+    caster: &RayCaster,
+    layout: Arc<PixelLayout>,
+    params: &BuildParams,
+    frames: Vec<Option<VertexFrame>>,
+    progress: &(dyn Fn(u64) + Sync),
+) -> (VisibilityMaps, BuildStats) {
+    assert_eq!(
+        frames.len(),
+        caster.receiver_count(),
+        "one map frame per receiver vertex"
+    );
     let offset = params.offset_relative * caster.diagonal();
     let max_t = params
         .max_distance
