@@ -48,6 +48,7 @@ mod python;
 mod repro_anim_compression;
 mod repro_btf;
 mod repro_btf_env;
+mod repro_btf_env_turns;
 mod repro_fins;
 mod repro_hemicube;
 mod repro_jumpmap;

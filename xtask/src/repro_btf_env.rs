@@ -13,7 +13,9 @@
 //! - PLS: the frame (γ of four view slots and the draw), median of 3.
 //!
 //! Frames are single-sample 512² on the adapter found (lavapipe proves correctness only).
-//! Writes `target/repro/btf-env.md`.
+//! Then, on the first mesh, static maps against M and the environment decomposition
+//! (`repro_btf_env_turns`). Writes `target/repro/btf-env.md`, `btf-env-decompose.svg` and
+//! `btf-env-oak.svg`.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -150,15 +152,15 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
         let turned = env
             .clone()
             .with_rotation(glam::Quat::from_rotation_arc(Vec3::Y, *up) * env.world_from_env());
-        let (_, cost) = cloth_vis::btf_stage::render_env(
-            Some(&gpu),
-            &pca,
-            object,
-            &turned,
-            3,
-            &camera,
-            &params,
-        )?;
+        let lighting = cloth_vis::btf_env::EnvLighting {
+            env: &turned,
+            up: *up,
+            rotation_deg: 0.0,
+            visibility: cloth_vis::btf_env::EnvVisibility::Matrix { level: 3 },
+            decompose: None,
+        };
+        let (_, cost) =
+            cloth_vis::btf_env::render_env(Some(&gpu), &pca, object, &lighting, &camera, &params)?;
         let n = object.positions.len();
         let seed = SEED
             .iter()
@@ -190,6 +192,12 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
          The seed's frame rates were on a Radeon 9700 at 1280×960; this machine's frames are \
          lavapipe's (CPU) and prove correctness, not speed."
     );
+    if let Some((object, up)) = meshes.first() {
+        let turned = env
+            .clone()
+            .with_rotation(glam::Quat::from_rotation_arc(Vec3::Y, *up) * env.world_from_env());
+        crate::repro_btf_env_turns::run(&mut md, out, &pca, object, &turned, *up)?;
+    }
     atomic_out::write_bytes(&out.join("btf-env.md"), md.as_bytes())?;
     println!("{md}");
     Ok(())

@@ -90,7 +90,7 @@ pub fn plain_material(pca: &BtfPca) -> Result<BtfPca, Error> {
 }
 
 /// The tangent frames of `object` (it needs UVs).
-fn tangents_of(object: &WorldObject) -> Result<(Vec<Vec4>, &[Vec2]), Error> {
+pub(crate) fn tangents_of(object: &WorldObject) -> Result<(Vec<Vec4>, &[Vec2]), Error> {
     let uvs = object.uvs.as_deref().ok_or_else(|| Error::Request {
         path: PathBuf::from(&object.name),
         message: "a BTF needs texture coordinates and this object has none".to_owned(),
@@ -100,7 +100,11 @@ fn tangents_of(object: &WorldObject) -> Result<(Vec<Vec4>, &[Vec2]), Error> {
     Ok((tangents, uvs))
 }
 
-fn btf_mesh<'a>(object: &'a WorldObject, tangents: &'a [Vec4], uvs: &'a [Vec2]) -> BtfMesh<'a> {
+pub(crate) fn btf_mesh<'a>(
+    object: &'a WorldObject,
+    tangents: &'a [Vec4],
+    uvs: &'a [Vec2],
+) -> BtfMesh<'a> {
     BtfMesh {
         positions: &object.positions,
         normals: &object.normals,
@@ -251,116 +255,6 @@ pub fn render_with_fins(
     ))
 }
 
-/// What lighting a BTF object by an environment cost ([`render_env`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct EnvCost {
-    /// Lightsphere directions k.
-    pub directions: usize,
-    /// Vertices lit.
-    pub vertices: usize,
-    /// Milliseconds of the visibility matrix M (occlusion-gpu's cpu backend).
-    pub visibility_ms: f64,
-    /// Milliseconds of the per-vertex transfer T_i (once per frame of a deforming mesh).
-    pub transfer_ms: f64,
-    /// Milliseconds of the environment update: W_i = T_i · L and γ* of the four view slots
-    /// (what a new map or a turned map costs).
-    pub update_ms: f64,
-    /// Milliseconds of the frame (draw and read-back; the CPU reference without a GPU).
-    pub render_ms: f64,
-}
-
-/// Renders `object` (with UVs) with `pca` under the environment `env` (thesis §5.5.2):
-/// the visibility matrix M of the object at lightsphere `level` (self-shadowing), the
-/// environment's cell-mean radiance I_j, the per-vertex transfer and W_i (crate `btf`,
-/// module `env`), and the frame with RGB γ* — on the GPU when `gpu` is given, else the CPU
-/// reference.
-///
-/// # Errors
-/// An object without UVs; lightsphere, visibility and rendering errors.
-#[allow(clippy::too_many_arguments)] // one frame's inputs; a struct would only rename them
-pub fn render_env(
-    gpu: Option<&GpuContext>,
-    pca: &BtfPca,
-    object: &WorldObject,
-    env: &lightsphere::Environment,
-    level: u32,
-    camera: &Camera,
-    params: &RenderParams,
-) -> Result<(HdrImage, EnvCost), Error> {
-    let (tangents, uvs) = tangents_of(object)?;
-    let sphere = lightsphere::Lightsphere::new(level)?;
-    let start = Instant::now();
-    let scene = occlusion_gpu::Scene::single(
-        object.positions.clone(),
-        object.normals.clone(),
-        object.triangles.clone(),
-    )?;
-    let mut engine =
-        occlusion_gpu::VisibilityEngine::cpu(occlusion_gpu::VisibilityParams::default());
-    let m = engine.compute(&scene, &sphere)?;
-    let visibility_ms = start.elapsed().as_secs_f64() * 1e3;
-    let radiance = env.radiance_per_direction(&sphere, lightsphere::RadianceMethod::CellMean)?;
-    let frames: Vec<[Vec3; 3]> = tangents
-        .iter()
-        .zip(&object.normals)
-        .map(|(t, n)| {
-            let n = n.normalize_or_zero();
-            let t3 = (t.truncate() - n * n.dot(t.truncate())).normalize_or_zero();
-            [t3, t.w * n.cross(t3), n]
-        })
-        .collect();
-    let omegas: Vec<f32> = sphere.solid_angles().iter().map(|&w| w as f32).collect();
-    let start = Instant::now();
-    let transfer = btf::env::EnvTransfer::build(
-        pca.sampling(),
-        &frames,
-        sphere.directions(),
-        &omegas,
-        |i, j| m.is_visible(i, j),
-    );
-    let transfer_ms = start.elapsed().as_secs_f64() * 1e3;
-    let start = Instant::now();
-    let mut w = Vec::new();
-    transfer.update(&radiance, &mut w);
-    let update_w_ms = start.elapsed().as_secs_f64() * 1e3;
-    let mesh = btf_mesh(object, &tangents, uvs);
-    let start = Instant::now();
-    let (image, gamma_ms) = match gpu {
-        Some(g) => {
-            let mut renderer = Renderer::new(&g.device, FrameFormat::single_sample(&g.device));
-            let btf =
-                GpuBtfRenderer::for_frame(&g.device, &g.queue, pca, &renderer.pass_context())?;
-            let t = Instant::now();
-            let draw = btf.prepare_env(&mesh, &w, camera, params)?;
-            let gamma_ms = t.elapsed().as_secs_f64() * 1e3;
-            let background = Background::Color(params.background.to_array());
-            (
-                renderer.render(&g.device, &g.queue, camera, background, &[&draw])?,
-                gamma_ms,
-            )
-        }
-        None => {
-            let image = btf::render::render_cpu_env(pca, &mesh, &w, camera, params)?;
-            (
-                HdrImage::new(camera.width, camera.height, image.to_rgba())?,
-                0.0,
-            )
-        }
-    };
-    let render_ms = start.elapsed().as_secs_f64() * 1e3 - gamma_ms;
-    Ok((
-        image,
-        EnvCost {
-            directions: sphere.len(),
-            vertices: object.positions.len(),
-            visibility_ms,
-            transfer_ms,
-            update_ms: update_w_ms + gamma_ms,
-            render_ms,
-        },
-    ))
-}
-
 /// The seed's display of a BTF render: linear radiance clamped to [0, 1], then sRGB-encoded
 /// (the normtextures are sRGB images, so a unit light shows them as measured); opaque.
 fn display() -> render::tone::Display {
@@ -407,6 +301,14 @@ pub fn side_by_side(left: &HdrImage, right: &HdrImage) -> image::RgbaImage {
     out
 }
 
+/// How the BTF objects of a scene frame are lit.
+enum Lit {
+    /// One light.
+    Light(Light),
+    /// Per chosen object, the environment binned per vertex (`btf::env`).
+    Environment(Vec<Vec<btf::env::EnvLightWeights>>),
+}
+
 /// One frame of the scene with `pca` on the BTF objects (a [`btf::render::BtfDraw`] each)
 /// and the Gouraud pass drawing the rest.
 #[allow(clippy::too_many_arguments)] // one frame's inputs; a struct would only rename them
@@ -416,7 +318,7 @@ fn scene_frame(
     pca: &BtfPca,
     chosen: &[&WorldObject],
     frames: &[(Vec<Vec4>, &[Vec2])],
-    light: &Light,
+    light: &Lit,
     look: &Look,
     params: &RenderParams,
     fins: Option<&crate::fins_stage::FinFrame>,
@@ -425,7 +327,14 @@ fn scene_frame(
     let draws = chosen
         .iter()
         .zip(frames)
-        .map(|(o, (t, uv))| btf.prepare(&btf_mesh(o, t, uv), light, &look.camera, params))
+        .enumerate()
+        .map(|(i, (o, (t, uv)))| {
+            let mesh = btf_mesh(o, t, uv);
+            match light {
+                Lit::Light(l) => btf.prepare(&mesh, l, &look.camera, params),
+                Lit::Environment(w) => btf.prepare_env(&mesh, &w[i], &look.camera, params),
+            }
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let mut passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
     if let Some(f) = fins {
@@ -452,6 +361,7 @@ pub(crate) fn run(
     renderer: &mut Renderer,
     objects: &[WorldObject],
     look: &Look,
+    environment: Option<&lightsphere::Environment>,
 ) -> Result<(Vec<PathBuf>, serde_json::Value), Error> {
     let desc = &scene.btf;
     let start = Instant::now();
@@ -490,6 +400,39 @@ pub(crate) fn run(
         dir_to_light_world: Vec3::from(desc.light_dir),
         radiance: Vec3::from(desc.radiance),
     };
+    let env_start = Instant::now();
+    let (lit, env_costs) = match (desc.illumination, environment) {
+        (crate::scene::BtfIllumination::Light, _) => (Lit::Light(light), Vec::new()),
+        (crate::scene::BtfIllumination::Environment, None) => {
+            return Err(Error::Scene {
+                origin: scene.origin.clone(),
+                message: "btf illumination = \"environment\" planned without an environment"
+                    .to_owned(),
+            });
+        }
+        (crate::scene::BtfIllumination::Environment, Some(env)) => {
+            let lighting = crate::btf_env::EnvLighting {
+                env,
+                up: Vec3::Y,
+                rotation_deg: 0.0,
+                visibility: match desc.maps {
+                    Some(res) => crate::btf_env::EnvVisibility::Maps {
+                        model: hemicube::Model::Hemicube { res },
+                    },
+                    None => crate::btf_env::EnvVisibility::Matrix { level: desc.level },
+                },
+                decompose: None,
+            };
+            let (ws, costs): (Vec<_>, Vec<_>) = chosen
+                .iter()
+                .map(|o| crate::btf_env::env_weights(&pca, o, &lighting))
+                .collect::<Result<Vec<_>, _>>()?
+                .into_iter()
+                .unzip();
+            (Lit::Environment(ws), costs)
+        }
+    };
+    let env_ms = env_start.elapsed().as_secs_f64() * 1e3;
     let mut params = RenderParams::default();
     params.uv_scale = Vec2::splat(desc.uv_scale);
     let fins = match &desc.fins {
@@ -521,13 +464,13 @@ pub(crate) fn run(
         &pca,
         &chosen,
         &frames,
-        &light,
+        &lit,
         look,
         &params,
         fins.as_ref(),
     )?;
     let with_plain = scene_frame(
-        gpu, renderer, &plain, &chosen, &frames, &light, look, &params, None,
+        gpu, renderer, &plain, &chosen, &frames, &lit, look, &params, None,
     )?;
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     let display = crate::run::display_for(scene, &with_btf);
@@ -552,6 +495,23 @@ pub(crate) fn run(
         "material_ms": material_ms,
         "render_ms": render_ms,
         "exposure_ev": display.exposure_ev,
+        "illumination": match desc.illumination {
+            crate::scene::BtfIllumination::Light => json!("light"),
+            crate::scene::BtfIllumination::Environment => json!({
+                "visibility": desc.maps.map_or_else(
+                    || format!("M at lightsphere level {}", desc.level),
+                    |r| format!("hemicube maps {r}x{r}"),
+                ),
+                "environment_ms": env_ms,
+                "objects": env_costs.iter().map(|c| json!({
+                    "vertices": c.vertices,
+                    "directions": c.directions,
+                    "visibility_ms": c.visibility_ms,
+                    "transfer_ms": c.transfer_ms,
+                    "update_ms": c.update_ms,
+                })).collect::<Vec<_>>(),
+            }),
+        },
         "fins": fins.as_ref().map(|f| json!({
             "source": desc.fins.as_ref().map(|d| d.source.clone()),
             "fins": f.fins,

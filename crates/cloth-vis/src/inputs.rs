@@ -224,7 +224,14 @@ fn load_file(path: &Path, scene: &Scene, index: usize) -> Result<Geometry, Error
         let frames = Arc::new(anim.frames);
         return Ok((positions, anim.triangles, anim.uvs, detail, Some(frames)));
     }
-    let (mesh, report) = meshio::load_mesh(path, &meshio::LoadOptions::default())?;
+    // A BTF needs one texture coordinate per vertex: with the `btf` effect, an OBJ's UV seams
+    // are split (normals stay welded, so the seams do not show in the shading).
+    let (mesh, report) = if scene.effects.iter().any(|e| e == "btf") {
+        let (split, report) = meshio::load_mesh_split_seams(path, &meshio::LoadOptions::default())?;
+        (split.mesh, report)
+    } else {
+        meshio::load_mesh(path, &meshio::LoadOptions::default())?
+    };
     let detail = json!({
         "source": path.display().to_string(),
         "unreferenced_vertices": report.unreferenced_vertices.len(),

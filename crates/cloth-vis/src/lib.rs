@@ -38,6 +38,7 @@
 //! # Ok::<(), cloth_vis::Error>(())
 //! ```
 
+pub mod btf_env;
 pub mod btf_stage;
 pub mod camera;
 pub mod deform;

@@ -100,7 +100,11 @@ impl Plan {
         for effect in &effects {
             stages.extend_from_slice(Stage::needed_by(*effect));
         }
-        if scene.environment.is_some() && scene.output.background == BackgroundDesc::ENVIRONMENT {
+        let btf_env = effects.contains(&Effect::Btf)
+            && scene.btf.illumination == crate::scene::BtfIllumination::Environment;
+        if scene.environment.is_some()
+            && (btf_env || scene.output.background == BackgroundDesc::ENVIRONMENT)
+        {
             stages.push(Stage::Environment);
         }
         stages.sort();

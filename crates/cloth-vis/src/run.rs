@@ -274,7 +274,15 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
 
         if plan.contains(Stage::Btf) {
             let written = timer.run(Stage::Btf, || {
-                crate::btf_stage::run(scene, tmp, &gpu, &mut renderer, &objects, &look)
+                crate::btf_stage::run(
+                    scene,
+                    tmp,
+                    &gpu,
+                    &mut renderer,
+                    &objects,
+                    &look,
+                    environment.as_ref(),
+                )
             })?;
             outputs.extend(written);
         }

@@ -383,3 +383,85 @@ fn render_under_an_environment_prints_its_costs_and_names_a_missing_map() {
     );
     assert!(!bad.exists());
 }
+
+/// `btf render --maps RES` (static hemicube maps, the thesis's path) lights the sphere as M does,
+/// `--decompose A,E` turns through eq. 5.13 and prints its error, and the flags that cannot
+/// work together are refused before any work.
+#[test]
+fn maps_and_the_decomposition_from_the_cli() {
+    let tmp = tempfile::tempdir().unwrap();
+    let btf_file = woven_btf(tmp.path(), "8");
+    let render = |extra: &[&str], png: &Path| {
+        let mut args = vec![
+            "btf",
+            "render",
+            "synth:sphere",
+            "--btf",
+            text(&btf_file),
+            "--sky",
+            "--rotation",
+            "30",
+            "--cpu",
+            "--size",
+            "48x48",
+            "--out",
+            text(png),
+        ];
+        args.extend_from_slice(extra);
+        cli(&args)
+    };
+    let (m_png, maps_png, dec_png) = (
+        tmp.path().join("m.png"),
+        tmp.path().join("maps.png"),
+        tmp.path().join("dec.png"),
+    );
+    let out = render(&["--level", "4"], &m_png);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = render(&["--maps", "16"], &maps_png);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("environment: 768 directions per vertex"),
+        "{}",
+        stdout(&out)
+    );
+    let (a, b) = (
+        image::open(&m_png).unwrap().to_rgb8(),
+        image::open(&maps_png).unwrap().to_rgb8(),
+    );
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (p, q) in a.pixels().zip(b.pixels()) {
+        if p.0 != [0, 0, 0] {
+            sum += (0..3).map(|c| f64::from(p[c].abs_diff(q[c]))).sum::<f64>() / 3.0;
+            n += 1;
+        }
+    }
+    let mean = sum / n as f64;
+    eprintln!("mean |M − maps| on the sphere: {mean:.2} (8-bit)");
+    assert!(
+        n > 300 && mean < 6.0,
+        "mean |M − maps| {mean} over {n} pixels"
+    );
+
+    let out = render(&["--level", "2", "--decompose", "6,3"], &dec_png);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let line = stdout(&out);
+    assert!(
+        line.contains("decomposition (eq. 5.13): 6 turns") && line.contains("3 components"),
+        "{line}"
+    );
+    assert!(line.contains("error against the direct update"), "{line}");
+
+    // Refused before any work: A = 1, a zero count, and --maps/--decompose with --frames.
+    let bad = tmp.path().join("bad.png");
+    for (extra, needle) in [
+        (&["--decompose", "1,1"][..], "turns"),
+        (&["--decompose", "5,0"][..], "at least 1"),
+        (&["--maps", "7"][..], "7"),
+        (&["--decompose", "4,2", "--frames", "0..2"][..], "--frames"),
+    ] {
+        let out = render(extra, &bad);
+        assert!(!out.status.success(), "{extra:?}");
+        assert!(stderr(&out).contains(needle), "{extra:?}: {}", stderr(&out));
+        assert!(!bad.exists(), "{extra:?} wrote a file");
+    }
+}

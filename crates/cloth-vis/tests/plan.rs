@@ -3,7 +3,7 @@
 
 mod common;
 
-use cloth_vis::{Plan, RunOptions, Stage, demo_scene, run_scene};
+use cloth_vis::{Plan, RunOptions, Scene, Stage, demo_scene, run_scene};
 use common::scene;
 
 const CLOTH: &str = r#"
@@ -56,6 +56,21 @@ fn btf_alone_plans_its_stage_and_no_lighting() {
     ))
     .unwrap();
     assert_eq!(plan.stages(), &[Stage::Geometry, Stage::Render, Stage::Btf]);
+    // Under environment light the map is loaded even on a black background.
+    let text = format!(
+        "effects = [\"btf\"]\n{CLOTH}\n[environment]\nsource = \"synth:sky\"\n\
+         [output]\nbackground = \"black\"\n[btf]\nillumination = \"environment\"\n"
+    );
+    let plan = Plan::for_scene(&scene(&text, ".".as_ref())).unwrap();
+    assert_eq!(
+        plan.stages(),
+        &[
+            Stage::Geometry,
+            Stage::Environment,
+            Stage::Render,
+            Stage::Btf
+        ]
+    );
 }
 
 #[test]
@@ -84,6 +99,35 @@ fn bad_btf_tables_are_named_before_any_work() {
         let err = Plan::for_scene(&scene(&text, dir.path()))
             .unwrap_err()
             .to_string();
+        assert!(err.contains(key), "{table}: {err}");
+    }
+    // Environment light needs an environment; fins stay with the directional light.
+    let env = "[environment]\nsource = \"synth:sky\"\n";
+    for (table, with_env, key) in [
+        ("illumination = \"environment\"", "", "btf.illumination"),
+        ("illumination = \"sunlight\"", env, "illumination"),
+        (
+            "illumination = \"environment\"\nfins = { source = \"synth:wool\" }",
+            env,
+            "btf.fins",
+        ),
+        (
+            "illumination = \"environment\"\nlevel = 9",
+            env,
+            "btf.level",
+        ),
+        ("illumination = \"environment\"\nmaps = 7", env, "btf.maps"),
+        (
+            "illumination = \"environment\"\nmaps = 4096",
+            env,
+            "btf.maps",
+        ),
+    ] {
+        let text = format!("effects = [\"btf\"]\n{CLOTH}\n{with_env}\n[btf]\n{table}\n");
+        let err = match Scene::from_toml(&text, dir.path(), "t") {
+            Err(e) => e.to_string(),
+            Ok(s) => Plan::for_scene(&s).unwrap_err().to_string(),
+        };
         assert!(err.contains(key), "{table}: {err}");
     }
     // Without the effect, the table is not checked (nothing of it runs).

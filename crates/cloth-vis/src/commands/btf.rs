@@ -309,7 +309,7 @@ pub enum BtfCommand {
     /// image.
     Stats(StatsArgs),
     /// Render a mesh with UVs textured by a compressed BTF under one light (§5.5), to PNG.
-    Render(super::btf_render::RenderArgs),
+    Render(Box<super::btf_render::RenderArgs>),
     /// Fin BTFs for silhouette enhancement of fuzzy cloth (§5.7): synth, compress.
     Fins {
         /// What to do.

@@ -17,14 +17,42 @@ pub enum RenderLight {
     Direction(Vec3),
     /// A point light at this world-space position (no distance falloff, eq. 5.4).
     Position(Vec3),
-    /// An environment (already turned onto the mesh's up axis and rotated), through the
-    /// mesh's own visibility at lightsphere `level` (§5.5.2).
+    /// An environment (already turned onto the mesh's up axis), turned by `rotation_deg`
+    /// about `up`, through the mesh's own visibility (§5.5.2).
     Environment {
         /// The map.
         env: Box<lightsphere::Environment>,
-        /// Lightsphere level of M and of the I_j.
-        level: u32,
+        /// The world up axis.
+        up: Vec3,
+        /// The turn about `up`, degrees.
+        rotation_deg: f32,
+        /// M at a lightsphere level, or static maps.
+        visibility: cloth_vis::btf_env::EnvVisibility,
+        /// Turn through the decomposition of eq. 5.13.
+        decompose: Option<cloth_vis::btf_env::Decompose>,
     },
+}
+
+impl RenderLight {
+    /// The environment lighting, when this is an environment.
+    fn env_lighting(&self) -> Option<cloth_vis::btf_env::EnvLighting<'_>> {
+        match self {
+            Self::Environment {
+                env,
+                up,
+                rotation_deg,
+                visibility,
+                decompose,
+            } => Some(cloth_vis::btf_env::EnvLighting {
+                env,
+                up: *up,
+                rotation_deg: *rotation_deg,
+                visibility: *visibility,
+                decompose: *decompose,
+            }),
+            _ => None,
+        }
+    }
 }
 
 /// What `cloth-vis btf render` was asked to do.
@@ -92,7 +120,7 @@ pub struct RenderSummary {
     /// What the fins cost, when drawn.
     pub fins: Option<cloth_vis::btf_stage::FinCost>,
     /// What the environment light cost, when lit by one.
-    pub env: Option<cloth_vis::btf_stage::EnvCost>,
+    pub env: Option<cloth_vis::btf_env::EnvCost>,
 }
 
 impl RenderSummary {
@@ -104,10 +132,23 @@ impl RenderSummary {
         );
         if let Some(e) = &self.env {
             line.push_str(&format!(
-                "; environment: {} directions, visibility {:.0} ms, transfer {:.0} ms, \
-                 environment update {:.1} ms for {} vertices, frame {:.0} ms",
+                "; environment: {} directions per vertex, visibility {:.0} ms, transfer {:.0} ms, \
+                 environment update: {:.1} ms for {} vertices, frame {:.0} ms",
                 e.directions, e.visibility_ms, e.transfer_ms, e.update_ms, e.vertices, e.render_ms
             ));
+            if let Some(d) = &e.decomposition {
+                line.push_str(&format!(
+                    "; decomposition (eq. 5.13): {} turns in {:.0} ms, PCA {:.0} ms, {} components \
+                     ({:.1} MB), turn {:.1} ms, error against the direct update {:.2} %",
+                    d.turns,
+                    d.samples_ms,
+                    d.build_ms,
+                    d.components,
+                    d.bytes as f64 / 1e6,
+                    d.turn_ms,
+                    100.0 * d.error
+                ));
+            }
         }
         if let Some(f) = &self.fins {
             line.push_str(&format!(
@@ -235,14 +276,13 @@ pub fn run_render(
     let mut params = btf::render::RenderParams::default();
     params.uv_scale = glam::Vec2::splat(request_.uv_scale);
     let Some(light) = one_light(&request_.light, request_.radiance) else {
-        let RenderLight::Environment { env, level } = &request_.light else {
+        let Some(lighting) = request_.light.env_lighting() else {
             return Err(request(&request_.out, "no light to render with".to_owned()));
         };
         {
             let start = Instant::now();
-            let (image, cost) = cloth_vis::btf_stage::render_env(
-                gpu, &pca, &object, env, *level, &camera, &params,
-            )?;
+            let (image, cost) =
+                cloth_vis::btf_env::render_env(gpu, &pca, &object, &lighting, &camera, &params)?;
             let picture = cloth_vis::btf_stage::single_auto_exposed(&image);
             let seconds = start.elapsed().as_secs_f64();
             figures::strip::write_png(&request_.out, &picture)?;
@@ -380,7 +420,7 @@ fn run_frames(
     params.uv_scale = glam::Vec2::splat(request_.uv_scale);
     let bar = cloth_vis::run::progress_bar(request_.progress, (end - start) as u64, "frames");
     let begin = Instant::now();
-    let mut sum: Option<cloth_vis::btf_stage::EnvCost> = None;
+    let mut sum: Option<cloth_vis::btf_env::EnvCost> = None;
     let mut exposure: Option<f32> = None;
     let mut size = [0, 0];
     atomic_out::write_dir(&request_.out, existing, |dir| {
@@ -399,16 +439,16 @@ fn run_frames(
                 Some(anim.uvs.clone()),
             );
             let picture = match (
-                &request_.light,
+                request_.light.env_lighting(),
                 one_light(&request_.light, request_.radiance),
             ) {
-                (RenderLight::Environment { env, level }, _) => {
-                    let (image, cost) = cloth_vis::btf_stage::render_env(
-                        gpu, pca, &object, env, *level, &camera, &params,
+                (Some(lighting), _) => {
+                    let (image, cost) = cloth_vis::btf_env::render_env(
+                        gpu, pca, &object, &lighting, &camera, &params,
                     )?;
                     sum = Some(match sum {
                         None => cost,
-                        Some(s) => cloth_vis::btf_stage::EnvCost {
+                        Some(s) => cloth_vis::btf_env::EnvCost {
                             visibility_ms: s.visibility_ms + cost.visibility_ms,
                             transfer_ms: s.transfer_ms + cost.transfer_ms,
                             update_ms: s.update_ms + cost.update_ms,
@@ -449,7 +489,7 @@ fn run_frames(
         backend: if gpu.is_some() { "gpu" } else { "cpu" },
         seconds: begin.elapsed().as_secs_f64(),
         fins: None,
-        env: sum.map(|s| cloth_vis::btf_stage::EnvCost {
+        env: sum.map(|s| cloth_vis::btf_env::EnvCost {
             visibility_ms: s.visibility_ms / n,
             transfer_ms: s.transfer_ms / n,
             update_ms: s.update_ms / n,
@@ -480,6 +520,7 @@ pub struct RenderArgs {
     /// Turn the environment by DEG degrees about the up axis.
     #[arg(
         long,
+        visible_alias = "rotation",
         value_name = "DEG",
         default_value_t = 0.0,
         allow_negative_numbers = true
@@ -488,6 +529,15 @@ pub struct RenderArgs {
     /// Lightsphere level of the environment's directions and the visibility (3: 258).
     #[arg(long, default_value_t = 3)]
     level: u32,
+    /// Shadow the environment through static per-vertex hemicube maps of RES² pixels per face
+    /// (the thesis's path) instead of the visibility matrix M at --level.
+    #[arg(long, value_name = "RES", conflicts_with = "frames")]
+    maps: Option<u32>,
+    /// Turn the environment through the decomposition of eq. 5.13: W for A turns (every
+    /// 360°/A), E components kept (the thesis: 30,5); prints its error against the direct
+    /// update at --env-rotation.
+    #[arg(long, value_name = "A,E", value_parser = super::parse::two_counts, conflicts_with = "frames")]
+    decompose: Option<(usize, usize)>,
     /// Point light: world position (no distance falloff).
     #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, allow_hyphen_values = true)]
     light_pos: Option<Vec3>,
@@ -549,9 +599,19 @@ impl RenderArgs {
                 env: Box::new(super::visibility::turned_environment(
                     env,
                     self.up_axis,
-                    self.env_rotation,
+                    0.0,
                 )),
-                level: self.level,
+                up: super::up_axis::up_axis_rotation(self.up_axis).as_quat() * Vec3::Y,
+                rotation_deg: self.env_rotation,
+                visibility: match self.maps {
+                    Some(res) => cloth_vis::btf_env::EnvVisibility::Maps {
+                        model: hemicube::Model::Hemicube { res },
+                    },
+                    None => cloth_vis::btf_env::EnvVisibility::Matrix { level: self.level },
+                },
+                decompose: self
+                    .decompose
+                    .map(|(turns, components)| cloth_vis::btf_env::Decompose { turns, components }),
             },
             (None, None, None) => anyhow::bail!(
                 "give the light: --light-dir X,Y,Z, --light-pos X,Y,Z, --env FILE.hdr or --sky"

@@ -16,6 +16,19 @@ pub fn range(text: &str) -> Result<(usize, usize), String> {
     Ok((a, b))
 }
 
+/// Parse `A,E`: two counts, each at least 1 (e.g. `--decompose 30,5`).
+pub fn two_counts(text: &str) -> Result<(usize, usize), String> {
+    let (a, e) = text
+        .split_once(',')
+        .ok_or_else(|| format!("{text:?} is not A,E (e.g. 30,5)"))?;
+    let count = |s: &str| match s.trim().parse::<usize>() {
+        Ok(0) => Err(format!("{s:?} in {text:?}: must be at least 1")),
+        Ok(n) => Ok(n),
+        Err(err) => Err(format!("{s:?} in {text:?}: {err}")),
+    };
+    Ok((count(a)?, count(e)?))
+}
+
 /// Parse `X,Y,Z` (finite).
 pub fn vec3(text: &str) -> Result<glam::Vec3, String> {
     let parts: Vec<&str> = text.split(',').collect();

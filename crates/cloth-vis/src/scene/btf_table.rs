@@ -39,6 +39,29 @@ pub struct BtfDesc {
     /// Fins along the BTF objects' silhouettes (§5.7), drawn on the BTF half of the picture.
     #[serde(default)]
     pub fins: Option<FinsDesc>,
+    /// `light` (the directional light above, eq. 5.4) or `environment`: the scene's
+    /// `[environment]` (its rotation included) through each BTF object's own self-shadowing
+    /// (§5.5.2, eqs. 5.10–5.11).
+    #[serde(default)]
+    pub illumination: BtfIllumination,
+    /// Lightsphere level of the visibility matrix M under `environment` (3: 258 directions).
+    #[serde(default = "default_btf_level")]
+    pub level: u32,
+    /// Shadow the environment through static hemicube maps of `maps`² pixels per face (the
+    /// thesis's path) instead of M; static objects only.
+    #[serde(default)]
+    pub maps: Option<u32>,
+}
+
+/// How the BTF objects are lit.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum BtfIllumination {
+    /// `[btf] light_dir` and `radiance`.
+    #[default]
+    Light,
+    /// The scene's environment.
+    Environment,
 }
 
 /// `[btf] fins = { source = "synth:wool" | "FILE.finpca", height = H, size = S }`.
@@ -74,6 +97,9 @@ fn default_btf_radiance() -> [f32; 3] {
 fn default_btf_uv_scale() -> f32 {
     6.0
 }
+fn default_btf_level() -> u32 {
+    3
+}
 fn default_btf_png() -> String {
     "btf.png".to_owned()
 }
@@ -90,6 +116,9 @@ impl Default for BtfDesc {
             uv_scale: default_btf_uv_scale(),
             png: default_btf_png(),
             fins: None,
+            illumination: BtfIllumination::Light,
+            level: default_btf_level(),
+            maps: None,
         }
     }
 }
@@ -157,6 +186,35 @@ impl Scene {
                 if let Some(v) = v.filter(|v| !(v.is_finite() && *v > 0.0 && *v < 1e9)) {
                     return Err(self.invalid(key, format!("{v} must be finite and > 0")));
                 }
+            }
+        }
+        if b.illumination == BtfIllumination::Environment {
+            if self.environment.is_none() {
+                return Err(self.invalid(
+                    "btf.illumination",
+                    "\"environment\" needs an [environment] (e.g. source = \"synth:sky\")"
+                        .to_owned(),
+                ));
+            }
+            if b.fins.is_some() {
+                return Err(self.invalid(
+                    "btf.fins",
+                    "fins are lit by the directional light only; use illumination = \"light\" \
+                     with fins"
+                        .to_owned(),
+                ));
+            }
+            if b.level > super::MAX_LEVEL {
+                return Err(self.invalid(
+                    "btf.level",
+                    format!("{} is outside 0..={}", b.level, super::MAX_LEVEL),
+                ));
+            }
+            if let Some(res) = b.maps.filter(|r| !(2..=256).contains(r) || !r.is_multiple_of(2)) {
+                return Err(self.invalid(
+                    "btf.maps",
+                    format!("{res} must be even and within 2..=256 (hemicube pixels per side)"),
+                ));
             }
         }
         if Path::new(&b.png)

@@ -41,7 +41,7 @@ mod shadow_table;
 mod static_table;
 mod translucency_table;
 
-pub use btf_table::{BtfDesc, FinsDesc};
+pub use btf_table::{BtfDesc, BtfIllumination, FinsDesc};
 pub use output::{
     AutoKeyword, BackgroundDesc, BackgroundKeyword, ExposureDesc, GroundDesc, OutputDesc, ToneDesc,
 };
