@@ -59,6 +59,7 @@
 
 mod error;
 mod gltf;
+mod materials;
 mod normals;
 mod npy;
 mod obj;
@@ -80,6 +81,7 @@ pub use gltf::{
     NORMAL_UNIT_TOLERANCE, text_gltf_buffer, write_glb, write_glb_animation,
     write_glb_animation_with, write_gltf_with,
 };
+pub use materials::{FaceMaterials, load_face_materials};
 pub use normals::{compute_normals, compute_normals_into};
 pub use npy::{NpyArray, read_npy_f32, write_npy_f32, write_npy_frames};
 pub use obj::{SeamSplit, load_mesh_split_seams};

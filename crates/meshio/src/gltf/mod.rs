@@ -116,6 +116,30 @@ pub(crate) fn load_gltf_mesh(
     finish_mesh(path, raw, options, report)
 }
 
+/// The per-triangle materials of the static load (see [`crate::FaceMaterials`]).
+pub(crate) fn face_materials(path: &Path) -> Result<crate::FaceMaterials, MeshIoError> {
+    let (src, rig, _) = open_rig(path)?;
+    let names = src
+        .document
+        .materials()
+        .map(|m| {
+            m.name().map_or_else(
+                || format!("material {}", m.index().unwrap_or(0)),
+                str::to_owned,
+            )
+        })
+        .collect();
+    let per_triangle = rig
+        .triangle_material
+        .iter()
+        .map(|m| m.and_then(|i| u32::try_from(i).ok()))
+        .collect();
+    Ok(crate::FaceMaterials {
+        names,
+        per_triangle,
+    })
+}
+
 /// Samples a clip of a glTF file.
 pub(crate) fn load_gltf_animation(
     path: &Path,

@@ -76,6 +76,8 @@ type DecodedMeshes = HashMap<(usize, Option<usize>), Arc<Vec<Decoded>>>;
 pub(crate) struct Primitive {
     /// Triangles this primitive contributes to the merged list.
     pub triangle_count: usize,
+    /// Its material index, if any.
+    pub material: Option<usize>,
     pub positions: Vec<Vec3>,
     pub normals: Option<Vec<Vec3>>,
     pub morph_positions: Vec<Vec<Vec3>>,
@@ -103,6 +105,8 @@ pub(crate) struct Rig {
     pub skins: Vec<Skin>,
     pub vertex_count: usize,
     pub triangles: Vec<[u32; 3]>,
+    /// Per merged triangle, its primitive's material index (`None`: the default material).
+    pub triangle_material: Vec<Option<usize>>,
     pub uvs: Option<Vec<Vec2>>,
     /// Every primitive has normals.
     pub has_normals: bool,
@@ -165,6 +169,7 @@ impl Rig {
             skins,
             vertex_count: 0,
             triangles: Vec::new(),
+            triangle_material: Vec::new(),
             uvs: Some(Vec::new()),
             has_normals: true,
             primitive_count: 0,
@@ -251,6 +256,10 @@ impl Rig {
             };
             self.triangles
                 .extend(part.triangles.iter().map(|t| t.map(|i| i + offset)));
+            self.triangle_material.extend(std::iter::repeat_n(
+                part.primitive.material,
+                part.triangles.len(),
+            ));
             self.primitive_count += 1;
             primitives.push(Arc::clone(&part.primitive));
         }
@@ -287,6 +296,7 @@ fn decode_mesh(
         parts.push(Decoded {
             primitive: Arc::new(Primitive {
                 triangle_count: triangles.len(),
+                material: primitive.material().index(),
                 ..prim
             }),
             triangles,
@@ -433,6 +443,7 @@ fn read_primitive(
     let triangles = triangulate(src, primitive.mode(), &indices, what)?;
     let prim = Primitive {
         triangle_count: 0,
+        material: None,
         positions,
         normals,
         morph_positions,

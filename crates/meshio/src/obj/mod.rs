@@ -12,7 +12,7 @@ use glam::{Vec2, Vec3};
 
 use crate::validate::{RawMesh, finish_mesh};
 use crate::{LoadOptions, LoadReport, Mesh, MeshIoError, SourceFormat};
-pub(crate) use parse::{ObjData, parse_obj};
+pub(crate) use parse::{NO_INDEX, ObjData, parse_obj};
 pub use seams::{SeamSplit, load_mesh_split_seams};
 
 /// Loads an OBJ file.
@@ -37,6 +37,7 @@ pub(crate) fn into_raw(obj: ObjData, report: &mut LoadReport) -> RawMesh {
         triangles,
         corner_tex,
         corner_normals,
+        ..
     } = obj;
     let n = positions.len();
     let uvs = corner_tex.and_then(|idx| {

@@ -1,5 +1,6 @@
 //! Wavefront OBJ parsing: `v`, `vt`, `vn` and `f` (corners `v`, `v/vt`, `v//vn`, `v/vt/vn`,
-//! 1-based or negative relative indices, polygons fan-triangulated). Every other keyword is
+//! 1-based or negative relative indices, polygons fan-triangulated) and `usemtl` (the material
+//! of each face, for per-face materials). Every other keyword is
 //! skipped and counted (the ARCSim garment files carry `vv` and `t` lines). Line continuations
 //! (`\` at the end of a line) are not supported.
 
@@ -25,6 +26,11 @@ pub(crate) struct ObjData {
     pub corner_tex: Option<Vec<[u32; 3]>>,
     /// `vn` index per triangle corner (present once any face has `vn`).
     pub corner_normals: Option<Vec<[u32; 3]>>,
+    /// `usemtl` names in order of first use.
+    pub material_names: Vec<String>,
+    /// Per triangle, the index into `material_names` of the `usemtl` in force, or
+    /// [`NO_INDEX`] before the first one.
+    pub triangle_material: Vec<u32>,
 }
 
 /// An index that points past what was defined when its face was read; checked at the end.
@@ -111,6 +117,7 @@ pub(crate) fn parse_obj(
     let mut corners: Vec<[u32; 3]> = Vec::new();
     let mut forward: Vec<ForwardRef> = Vec::new();
     let mut face = 0usize;
+    let mut material = NO_INDEX;
     for (line, text) in Lines::new(data, 1) {
         let mut words = tokens(text);
         let Some(keyword) = words.next() else {
@@ -147,6 +154,19 @@ pub(crate) fn parse_obj(
                 )?;
                 obj.normals.push(Vec3::from_array(n));
             }
+            b"usemtl" => {
+                let name = words
+                    .map(|w| String::from_utf8_lossy(w).into_owned())
+                    .collect::<Vec<_>>()
+                    .join(" ");
+                material = match obj.material_names.iter().position(|n| *n == name) {
+                    Some(i) => i as u32,
+                    None => {
+                        obj.material_names.push(name);
+                        (obj.material_names.len() - 1) as u32
+                    }
+                };
+            }
             b"f" => {
                 corners.clear();
                 for word in words {
@@ -163,6 +183,9 @@ pub(crate) fn parse_obj(
                     });
                 }
                 push_fan(&mut obj, &corners);
+                let fan = corners.len() - 2;
+                obj.triangle_material
+                    .extend(std::iter::repeat_n(material, fan));
                 if corners.len() > 3 {
                     report.polygons_triangulated += 1;
                 }
