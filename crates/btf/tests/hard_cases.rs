@@ -2,9 +2,13 @@
 //! cases stay numerically stable"), and of the BTF folder reader (issue #12): image headers
 //! that claim more pixels than their files hold, and a FIFO named like an image; fin geometry
 //! (no silhouette, border, crease, offset 1e5) and the fin BTF (black and constant image sets,
-//! the alpha cut, a 10⁴× light).
+//! the alpha cut, a 10⁴× light); under environment light (§5.5.2), a seam in the tangent frame
+//! and a view at θ = 0 (the others — every direction occluded, a light exactly at a measured
+//! direction, a 10⁴× sun — are in `env_light.rs`).
 
 mod common;
+#[path = "common/env.rs"]
+mod env_common;
 
 use btf::{BtfPca, BtfPcaParams, DIRECTIONS, Sampling, Storage, ViewSlot};
 use common::{analytic, analytic_pca, analytic_slot, assert_close};
@@ -600,5 +604,93 @@ mod fin_btf {
             f.iter().all(|c| c.is_finite()) && (f[0] - 2e3).abs() < 2.0,
             "{f:?}"
         );
+    }
+}
+
+/// Two copies of one vertex at a UV seam: same position and normal, the tangent turned and the
+/// bitangent mirrored on one side. Each bins the same sky onto its own measured directions, so
+/// W differs, but an isotropic (Lambertian) BTF must show the same radiance on both sides: the
+/// seam does not show. An anisotropic W pattern proves the frames were really different.
+#[test]
+fn env_seam_in_the_tangent_frame() {
+    use btf::env::{EnvLightWeights, EnvTransfer};
+    let s = Sampling::H1;
+    let (pca, lam) = env_common::lambertian(s);
+    let (dirs, omega) = env_common::sphere_directions(20_000);
+    let omegas = vec![omega; dirs.len()];
+    let n = Vec3::new(0.3, 0.8, 0.52).normalize();
+    let t = n.any_orthonormal_vector();
+    let a = 1.1f32;
+    let t2 = t * a.cos() + n.cross(t) * a.sin();
+    let frames = [[t, n.cross(t), n], [t2, -n.cross(t2), n]];
+    // A coloured sky with a sun, half hidden by a wall.
+    let sun = Vec3::new(0.5, 0.7, -0.2).normalize();
+    let sky = |d: Vec3| {
+        Vec3::new(0.4 + d.y.max(0.0), 0.5, 0.6 - 0.3 * d.x)
+            + 50.0 * Vec3::ONE * d.dot(sun).max(0.0).powf(64.0)
+    };
+    let visible = |_: usize, d: usize| dirs[d].x + 0.3 * dirs[d].z < 0.2;
+    let transfer = EnvTransfer::build(s, &frames, &dirs, &omegas, visible);
+    let l: Vec<Vec3> = dirs.iter().map(|&d| sky(d)).collect();
+    let mut w: Vec<EnvLightWeights> = Vec::new();
+    transfer.update(&l, &mut w);
+    let differ = (0..DIRECTIONS)
+        .filter(|&m| (w[0].weights[m] - w[1].weights[m]).abs().max_element() > 1e-3)
+        .count();
+    assert!(
+        differ > 10,
+        "the two frames bin the sky alike ({differ} directions differ)"
+    );
+    for view in [
+        n,
+        (n + 0.6 * t).normalize(),
+        (n - 0.5 * t2 + 0.3 * n.cross(t)).normalize(),
+    ] {
+        let rgb: Vec<[f32; 3]> = frames
+            .iter()
+            .zip(&w)
+            .map(|(f, wi)| {
+                let local = Vec3::new(view.dot(f[0]), view.dot(f[1]), view.dot(f[2]));
+                pca.eval_env(local, wi, 0.1, 0.1)
+            })
+            .collect();
+        let want = lam.albedo(0, 0);
+        for c in 0..3 {
+            assert!(
+                (rgb[0][c] - rgb[1][c]).abs() <= 0.01 * rgb[0][c].abs().max(1e-3),
+                "view {view}: {rgb:?} (albedo {want})"
+            );
+        }
+    }
+}
+
+/// A view along the normal under an environment uses view slot 0 alone, and the result is
+/// finite for every azimuth the tangent frame could give it.
+#[test]
+fn env_view_at_theta_zero() {
+    use btf::env::EnvLightWeights;
+    let s = Sampling::H2;
+    let pca = analytic_pca(s, 4, &BtfPcaParams::default());
+    let mut w = EnvLightWeights::default();
+    let dirs: Vec<Vec3> = (0..DIRECTIONS).map(|i| s.vector(i)).collect();
+    let l: Vec<Vec3> = (0..DIRECTIONS)
+        .map(|i| Vec3::splat(0.1 + 0.01 * i as f32))
+        .collect();
+    w.add_samples(s, [Vec3::X, Vec3::Y, Vec3::Z], &dirs, &l, |_| true);
+    let mut gamma = vec![Vec3::ZERO; pca.gamma_len(0)];
+    pca.env_gamma(0, &w, &mut gamma);
+    let slot0 = pca.texel_rgb(0, &gamma, 1, 2);
+    for view in [
+        Vec3::Z,
+        Vec3::new(-0.0, 0.0, 1.0),
+        Vec3::new(0.0, -0.0, 3.0),
+    ] {
+        let u = (1.0 + 0.5) / pca.width() as f32;
+        let v = (2.0 + 0.5) / pca.height() as f32;
+        let rgb = pca.eval_env(view, &w, u, v);
+        assert!(rgb.iter().all(|c| c.is_finite()), "{rgb:?}");
+        for c in 0..3 {
+            assert_close(f64::from(rgb[c]), f64::from(slot0[c]), 1e-6, "slot 0 alone");
+        }
     }
 }

@@ -13,20 +13,17 @@
 //! is drawn by the Gouraud pass with its lighting, all against one depth buffer, so BTF
 //! objects and plain objects occlude each other.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use btf::render::{BtfMesh, GpuBtfRenderer, Light, RenderParams};
 use btf::{BtfPca, BtfPcaParams, Sampling, ViewSlot};
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec4};
 use gpu_context::{GpuContext, HdrImage};
 use render::{Background, Camera, FrameFormat, FramePass, Renderer};
-use serde_json::json;
 
 use crate::Error;
 use crate::object::WorldObject;
-use crate::run::Look;
-use crate::scene::Scene;
 
 /// The woven BTF generated for `synth:woven`, compressed in memory with `components` terms
 /// per view slot (H1 sampling).
@@ -289,6 +286,75 @@ pub fn single_exposed(image: &HdrImage, exposure_ev: f32) -> image::RgbaImage {
         .unwrap_or_else(|| image::RgbaImage::new(image.width(), image.height()))
 }
 
+/// The triangles of `object` whose face material is `material` (per triangle in
+/// `per_triangle`), as an object with the same vertices (so per-vertex data such as the
+/// environment's W stays indexed alike); `None` when no triangle has it.
+pub fn material_part(
+    object: &WorldObject,
+    per_triangle: &[Option<u32>],
+    material: Option<u32>,
+    name: &str,
+) -> Option<WorldObject> {
+    let triangles: Vec<[u32; 3]> = object
+        .triangles
+        .iter()
+        .zip(per_triangle)
+        .filter(|(_, m)| **m == material)
+        .map(|(t, _)| *t)
+        .collect();
+    (!triangles.is_empty()).then(|| {
+        WorldObject::textured(
+            name,
+            object.positions.clone(),
+            object.normals.clone(),
+            triangles,
+            object.uvs.clone(),
+        )
+    })
+}
+
+/// Renders the parts of a mesh, each with its own BTF (thesis §5.6: garment parts), in one
+/// GPU frame with one depth buffer, under `lit` (for [`Lit::Environment`], one W per part,
+/// indexed by the part's vertices).
+///
+/// # Errors
+/// A part without UVs; renderer errors.
+pub fn render_parts(
+    gpu: &GpuContext,
+    parts: &[(&BtfPca, &WorldObject)],
+    lit: &Lit,
+    camera: &Camera,
+    params: &RenderParams,
+) -> Result<HdrImage, Error> {
+    let mut renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
+    let frames = parts
+        .iter()
+        .map(|(_, o)| tangents_of(o))
+        .collect::<Result<Vec<_>, _>>()?;
+    let btfs = parts
+        .iter()
+        .map(|(pca, _)| {
+            GpuBtfRenderer::for_frame(&gpu.device, &gpu.queue, pca, &renderer.pass_context())
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let draws = parts
+        .iter()
+        .zip(&frames)
+        .zip(&btfs)
+        .enumerate()
+        .map(|(i, (((_, o), (t, uv)), btf))| {
+            let mesh = btf_mesh(o, t, uv);
+            match lit {
+                Lit::Light(l) => btf.prepare(&mesh, l, camera, params),
+                Lit::Environment(w) => btf.prepare_env(&mesh, &w[i], camera, params),
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
+    let background = Background::Color(params.background.to_array());
+    Ok(renderer.render(&gpu.device, &gpu.queue, camera, background, &passes)?)
+}
+
 /// Two images of one size side by side, as 8-bit RGBA.
 pub fn side_by_side(left: &HdrImage, right: &HdrImage) -> image::RgbaImage {
     let (l, r) = (single(left), single(right));
@@ -301,224 +367,11 @@ pub fn side_by_side(left: &HdrImage, right: &HdrImage) -> image::RgbaImage {
     out
 }
 
-/// How the BTF objects of a scene frame are lit.
-enum Lit {
+/// How the BTF objects of a frame are lit.
+#[derive(Clone, Debug)]
+pub enum Lit {
     /// One light.
     Light(Light),
     /// Per chosen object, the environment binned per vertex (`btf::env`).
     Environment(Vec<Vec<btf::env::EnvLightWeights>>),
-}
-
-/// One frame of the scene with `pca` on the BTF objects (a [`btf::render::BtfDraw`] each)
-/// and the Gouraud pass drawing the rest.
-#[allow(clippy::too_many_arguments)] // one frame's inputs; a struct would only rename them
-fn scene_frame(
-    gpu: &GpuContext,
-    renderer: &mut Renderer,
-    pca: &BtfPca,
-    chosen: &[&WorldObject],
-    frames: &[(Vec<Vec4>, &[Vec2])],
-    light: &Lit,
-    look: &Look,
-    params: &RenderParams,
-    fins: Option<&crate::fins_stage::FinFrame>,
-) -> Result<HdrImage, Error> {
-    let btf = GpuBtfRenderer::for_frame(&gpu.device, &gpu.queue, pca, &renderer.pass_context())?;
-    let draws = chosen
-        .iter()
-        .zip(frames)
-        .enumerate()
-        .map(|(i, (o, (t, uv)))| {
-            let mesh = btf_mesh(o, t, uv);
-            match light {
-                Lit::Light(l) => btf.prepare(&mesh, l, &look.camera, params),
-                Lit::Environment(w) => btf.prepare_env(&mesh, &w[i], &look.camera, params),
-            }
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
-    if let Some(f) = fins {
-        passes.extend(f.draws.iter().map(|d| d as &dyn FramePass));
-    }
-    Ok(renderer.render(
-        &gpu.device,
-        &gpu.queue,
-        &look.camera,
-        look.background,
-        &passes,
-    )?)
-}
-
-/// Runs the `btf` stage of a scene: material, plain companion, both frames, the PNG (left:
-/// BTF, right: plain texture mapping, one exposure for both halves).
-///
-/// # Errors
-/// Material, object and rendering errors; write errors naming the PNG.
-pub(crate) fn run(
-    scene: &Scene,
-    out_dir: &Path,
-    gpu: &GpuContext,
-    renderer: &mut Renderer,
-    objects: &[WorldObject],
-    look: &Look,
-    environment: Option<&lightsphere::Environment>,
-) -> Result<(Vec<PathBuf>, serde_json::Value), Error> {
-    let desc = &scene.btf;
-    let start = Instant::now();
-    let (pca, source) = match scene.btf_source()? {
-        crate::scene::BtfSource::SynthWoven => (
-            synth_material(desc.res, desc.components)?,
-            format!("synth:woven ({0}x{0})", desc.res),
-        ),
-        crate::scene::BtfSource::File(path) => (BtfPca::read(&path)?, path.display().to_string()),
-    };
-    let material_ms = start.elapsed().as_secs_f64() * 1e3;
-    let plain = plain_material(&pca)?;
-    let chosen: Vec<&WorldObject> = objects
-        .iter()
-        .filter(|o| {
-            if desc.objects.is_empty() {
-                o.uvs.is_some() && o.name != crate::scene::GROUND_NAME
-            } else {
-                desc.objects.contains(&o.name)
-            }
-        })
-        .collect();
-    if chosen.is_empty() {
-        return Err(Error::Request {
-            path: PathBuf::from("btf.objects"),
-            message: "no object to draw with the BTF".to_owned(),
-        });
-    }
-    let frames = chosen
-        .iter()
-        .map(|o| tangents_of(o))
-        .collect::<Result<Vec<_>, _>>()?;
-    let names: Vec<&str> = chosen.iter().map(|o| o.name.as_str()).collect();
-    crate::run::set_gouraud_meshes(gpu, renderer, objects, &look.camera, &names)?;
-    let light = Light::Directional {
-        dir_to_light_world: Vec3::from(desc.light_dir),
-        radiance: Vec3::from(desc.radiance),
-    };
-    let env_start = Instant::now();
-    let (lit, env_costs) = match (desc.illumination, environment) {
-        (crate::scene::BtfIllumination::Light, _) => (Lit::Light(light), Vec::new()),
-        (crate::scene::BtfIllumination::Environment, None) => {
-            return Err(Error::Scene {
-                origin: scene.origin.clone(),
-                message: "btf illumination = \"environment\" planned without an environment"
-                    .to_owned(),
-            });
-        }
-        (crate::scene::BtfIllumination::Environment, Some(env)) => {
-            let lighting = crate::btf_env::EnvLighting {
-                env,
-                up: Vec3::Y,
-                rotation_deg: 0.0,
-                visibility: match desc.maps {
-                    Some(res) => crate::btf_env::EnvVisibility::Maps {
-                        model: hemicube::Model::Hemicube { res },
-                    },
-                    None => crate::btf_env::EnvVisibility::Matrix { level: desc.level },
-                },
-                decompose: None,
-            };
-            let (ws, costs): (Vec<_>, Vec<_>) = chosen
-                .iter()
-                .map(|o| crate::btf_env::env_weights(&pca, o, &lighting))
-                .collect::<Result<Vec<_>, _>>()?
-                .into_iter()
-                .unzip();
-            (Lit::Environment(ws), costs)
-        }
-    };
-    let env_ms = env_start.elapsed().as_secs_f64() * 1e3;
-    let mut params = RenderParams::default();
-    params.uv_scale = Vec2::splat(desc.uv_scale);
-    let fins = match &desc.fins {
-        Some(f) => {
-            let source = match f.source.as_str() {
-                crate::fins_stage::SYNTH_WOOL => crate::fins_stage::FinSource::SynthWool,
-                file => crate::fins_stage::FinSource::File(scene.base_dir.join(file)),
-            };
-            let fin_pca = source.load(btf::DEFAULT_COMPONENTS)?;
-            let (_, radius) = render::bounding_sphere(chosen.iter().flat_map(|o| &o.positions))
-                .unwrap_or((Vec3::ZERO, 1.0));
-            let look_fins = crate::fins_stage::FinLook::for_radius(radius, f.height, f.size);
-            let fin_renderer =
-                crate::fins_stage::fin_renderer(&gpu.device, &fin_pca, &renderer.pass_context())?;
-            Some(crate::fins_stage::fin_frame(
-                &fin_renderer,
-                &chosen,
-                &light,
-                &look.camera,
-                &look_fins,
-            )?)
-        }
-        None => None,
-    };
-    let render_start = Instant::now();
-    let with_btf = scene_frame(
-        gpu,
-        renderer,
-        &pca,
-        &chosen,
-        &frames,
-        &lit,
-        look,
-        &params,
-        fins.as_ref(),
-    )?;
-    let with_plain = scene_frame(
-        gpu, renderer, &plain, &chosen, &frames, &lit, look, &params, None,
-    )?;
-    let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
-    let display = crate::run::display_for(scene, &with_btf);
-    let left = render::output::to_rgba8(&with_btf, &display, look.background);
-    let right = render::output::to_rgba8(&with_plain, &display, look.background);
-    let (w, h) = (with_btf.width() as usize, with_btf.height() as usize);
-    let mut both = Vec::with_capacity(2 * left.len());
-    for row in 0..h {
-        both.extend_from_slice(&left[row * w * 4..(row + 1) * w * 4]);
-        both.extend_from_slice(&right[row * w * 4..(row + 1) * w * 4]);
-    }
-    let path = out_dir.join(&desc.png);
-    gpu_context::write_rgba8_png(&path, &both, 2 * w as u32, h as u32)?;
-    let kept = pca.slots().iter().map(|s| s.components());
-    let params = json!({
-        "source": source,
-        "objects": names,
-        "size": [pca.width(), pca.height()],
-        "components": [kept.clone().min().unwrap_or(0), kept.max().unwrap_or(0)],
-        "light_dir": desc.light_dir,
-        "uv_scale": desc.uv_scale,
-        "material_ms": material_ms,
-        "render_ms": render_ms,
-        "exposure_ev": display.exposure_ev,
-        "illumination": match desc.illumination {
-            crate::scene::BtfIllumination::Light => json!("light"),
-            crate::scene::BtfIllumination::Environment => json!({
-                "visibility": desc.maps.map_or_else(
-                    || format!("M at lightsphere level {}", desc.level),
-                    |r| format!("hemicube maps {r}x{r}"),
-                ),
-                "environment_ms": env_ms,
-                "objects": env_costs.iter().map(|c| json!({
-                    "vertices": c.vertices,
-                    "directions": c.directions,
-                    "visibility_ms": c.visibility_ms,
-                    "transfer_ms": c.transfer_ms,
-                    "update_ms": c.update_ms,
-                })).collect::<Vec<_>>(),
-            }),
-        },
-        "fins": fins.as_ref().map(|f| json!({
-            "source": desc.fins.as_ref().map(|d| d.source.clone()),
-            "fins": f.fins,
-            "extract_ms": f.extract_ms,
-            "prepare_ms": f.prepare_ms,
-        })),
-        "image": "left: BTF (§5.5, with fins §5.7 when asked), right: plain texture mapping (frontal normtexture); other objects Gouraud, one depth buffer",
-    });
-    Ok((vec![path], params))
 }

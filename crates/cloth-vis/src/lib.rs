@@ -39,6 +39,7 @@
 //! ```
 
 pub mod btf_env;
+mod btf_scene;
 pub mod btf_stage;
 pub mod camera;
 pub mod deform;

@@ -274,7 +274,7 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
 
         if plan.contains(Stage::Btf) {
             let written = timer.run(Stage::Btf, || {
-                crate::btf_stage::run(
+                crate::btf_scene::run(
                     scene,
                     tmp,
                     &gpu,

@@ -465,3 +465,135 @@ fn maps_and_the_decomposition_from_the_cli() {
         assert!(!bad.exists(), "{extra:?} wrote a file");
     }
 }
+
+/// An OBJ sheet facing +z in an n × n grid with UVs: triangles left of x = 0.5 under
+/// `usemtl left`, the rest under `usemtl right`.
+fn two_part_sheet(n: usize) -> String {
+    let mut obj = String::new();
+    for r in 0..=n {
+        for c in 0..=n {
+            let (x, y) = (c as f32 / n as f32, r as f32 / n as f32);
+            obj.push_str(&format!("v {x} {y} 0\nvt {x} {y}\n"));
+        }
+    }
+    for (material, cols) in [("left", 0..n / 2), ("right", n / 2..n)] {
+        obj.push_str(&format!("usemtl {material}\n"));
+        for r in 0..n {
+            for c in cols.clone() {
+                let i = r * (n + 1) + c + 1;
+                let j = i + n + 1;
+                obj.push_str(&format!(
+                    "f {i}/{i} {}/{} {}/{} {j}/{j}\n",
+                    i + 1,
+                    i + 1,
+                    j + 1,
+                    j + 1
+                ));
+            }
+        }
+    }
+    obj
+}
+
+/// `btf render --part NAME=FILE` (garment parts, §5.6): the faces of material NAME wear FILE,
+/// every other face keeps --btf — pixel for pixel against the single-material render.
+#[test]
+fn parts_wear_their_own_btf_and_the_rest_is_untouched() {
+    if gpu_context::GpuContext::new(&gpu_context::GpuOptions::default()).is_err() {
+        test_data::skip::<()>("no GPU adapter for the parts render test");
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let woven = woven_btf(tmp.path(), "8");
+    // The same material with one component: visibly different shading, same size.
+    let flat = tmp.path().join("flat.btfpca");
+    let out = cli(&[
+        "btf",
+        "compress",
+        text(&tmp.path().join("w")),
+        "--components",
+        "1",
+        "--out",
+        text(&flat),
+        "--quiet",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mesh = tmp.path().join("sheet.obj");
+    std::fs::write(&mesh, two_part_sheet(16)).unwrap();
+    let render = |extra: &[&str], png: &Path| {
+        let mut args = vec![
+            "btf",
+            "render",
+            text(&mesh),
+            "--btf",
+            text(&woven),
+            "--light-dir",
+            "0.3,0.4,0.9",
+            "--camera-dir",
+            "0,0,1",
+            "--size",
+            "64x64",
+            "--out",
+            text(png),
+        ];
+        args.extend_from_slice(extra);
+        cli(&args)
+    };
+    let (one, two) = (tmp.path().join("one.png"), tmp.path().join("two.png"));
+    let out = render(&[], &one);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let part = format!("right={}", text(&flat));
+    let out = render(&["--part", &part], &two);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (a, b) = (
+        image::open(&one).unwrap().to_rgb8(),
+        image::open(&two).unwrap().to_rgb8(),
+    );
+    // The sheet fills the middle of the frame; its left half keeps the woven BTF exactly, its
+    // right half changes. Columns near the border are left out (the camera frames the sheet).
+    let (mut left_changed, mut right_changed) = (0, 0);
+    for y in 16..48 {
+        for x in 12..28 {
+            left_changed += usize::from(a.get_pixel(x, y) != b.get_pixel(x, y));
+        }
+        for x in 36..52 {
+            right_changed += usize::from(a.get_pixel(x, y) != b.get_pixel(x, y));
+        }
+    }
+    assert_eq!(left_changed, 0, "the left part kept --btf");
+    assert!(
+        right_changed > 200,
+        "only {right_changed} right pixels changed"
+    );
+
+    // Unknown material, a mesh without materials, the same part twice: named, nothing written.
+    let bad = tmp.path().join("bad.png");
+    let missing = format!("collar={}", text(&flat));
+    let out = render(&["--part", &missing], &bad);
+    assert!(
+        !out.status.success() && stderr(&out).contains("\"left\", \"right\""),
+        "{}",
+        stderr(&out)
+    );
+    let out = render(&["--part", &part, "--part", &part], &bad);
+    assert!(
+        !out.status.success() && stderr(&out).contains("twice"),
+        "{}",
+        stderr(&out)
+    );
+    let out = cli(&[
+        "btf",
+        "render",
+        "synth:sphere",
+        "--btf",
+        text(&woven),
+        "--light-dir",
+        "0,0,1",
+        "--part",
+        &part,
+        "--out",
+        text(&bad),
+    ]);
+    assert!(!out.status.success(), "{}", stderr(&out));
+    assert!(!bad.exists());
+}

@@ -282,3 +282,86 @@ fn a_scene_lights_the_btf_by_its_environment_and_maps_agree_with_m() {
     assert!(to_light > 10.0, "{to_light}");
     assert!(to_maps < 4.0, "{to_maps}");
 }
+
+/// `[btf] parts` (garment parts, §5.6): the faces of an OBJ's `usemtl right` wear their own BTF
+/// in both halves, the rest of the sheet is pixel for pixel the single-material render, and a
+/// part no object has is named.
+#[test]
+fn scene_parts_dress_each_face_material_in_its_own_btf() {
+    if !gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let n = 12;
+    let mut obj = String::new();
+    for r in 0..=n {
+        for c in 0..=n {
+            let (x, y) = (c as f32 / n as f32, r as f32 / n as f32);
+            obj.push_str(&format!("v {x} {y} 0\nvt {x} {y}\n"));
+        }
+    }
+    for (material, cols) in [("left", 0..n / 2), ("right", n / 2..n)] {
+        obj.push_str(&format!("usemtl {material}\n"));
+        for r in 0..n {
+            for c in cols.clone() {
+                let i = r * (n + 1) + c + 1;
+                let j = i + n + 1;
+                obj.push_str(&format!(
+                    "f {i}/{i} {}/{} {}/{} {j}/{j}\n",
+                    i + 1,
+                    i + 1,
+                    j + 1,
+                    j + 1
+                ));
+            }
+        }
+    }
+    std::fs::write(dir.path().join("sheet.obj"), obj).unwrap();
+    cloth_vis::btf_stage::synth_material(8, 1)
+        .unwrap()
+        .write(&dir.path().join("flat.btfpca"))
+        .unwrap();
+    let text = |parts: &str| {
+        format!(
+            "effects = [\"btf\"]\n[[object]]\nname = \"sheet\"\nsource = \"sheet.obj\"\n\
+             [camera]\nwidth = 64\nheight = 64\ndirection = [0.0, 0.0, 1.0]\n\
+             [output]\nbackground = \"black\"\nexposure = 0.0\n\
+             [btf]\nres = 8\nlight_dir = [0.3, 0.4, 0.9]\n{parts}\n"
+        )
+    };
+    let run = |parts: &str, out: &str| {
+        let scene = Scene::from_toml(&text(parts), dir.path(), "parts").unwrap();
+        let out = dir.path().join(out);
+        run_scene(&scene, &out, &RunOptions::default())
+            .map(|_| image::open(out.join("btf.png")).unwrap().to_rgb8())
+    };
+    let one = run("", "one").unwrap();
+    let two = run("parts = { right = \"flat.btfpca\" }", "two").unwrap();
+    // Each half of btf.png (BTF | plain) is 64 wide; the sheet's left material is x < 32.
+    let (mut left, mut right) = (0, 0);
+    for half in [0u32, 64] {
+        for y in 12..52 {
+            for x in 8..26 {
+                left += usize::from(one.get_pixel(half + x, y) != two.get_pixel(half + x, y));
+            }
+            for x in 38..56 {
+                right += usize::from(one.get_pixel(half + x, y) != two.get_pixel(half + x, y));
+            }
+        }
+    }
+    assert_eq!(left, 0, "the left material kept [btf] source");
+    assert!(right > 300, "only {right} pixels of the right part changed");
+    let err = run("parts = { sleeve = \"flat.btfpca\" }", "three")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("btf.parts.sleeve"), "{err}");
+    let bad = Scene::from_toml(
+        &text("parts = { right = \"none.btfpca\" }"),
+        dir.path(),
+        "p",
+    )
+    .map_err(|e| e.to_string())
+    .and_then(|s| Plan::for_scene(&s).map(|_| ()).map_err(|e| e.to_string()))
+    .unwrap_err();
+    assert!(bad.contains("btf.parts.right"), "{bad}");
+}

@@ -35,7 +35,7 @@ pub enum RenderLight {
 
 impl RenderLight {
     /// The environment lighting, when this is an environment.
-    fn env_lighting(&self) -> Option<cloth_vis::btf_env::EnvLighting<'_>> {
+    pub(super) fn env_lighting(&self) -> Option<cloth_vis::btf_env::EnvLighting<'_>> {
         match self {
             Self::Environment {
                 env,
@@ -87,6 +87,9 @@ pub struct RenderRequest {
     /// Frames A..B of an animated input (`synth:cloth`): `out` is then a folder of
     /// frame-NNNN.png, each lit with that frame's own visibility.
     pub frames: Option<(usize, usize)>,
+    /// Garment parts (§5.6): faces of material NAME (OBJ `usemtl`, glTF material) wear the
+    /// BTF of FILE; the other faces wear `btf`.
+    pub parts: Vec<(String, PathBuf)>,
     /// The PNG to write (a folder with `frames`).
     pub out: PathBuf,
     /// Show a progress bar over frames.
@@ -275,6 +278,9 @@ pub fn run_render(
     let camera = framing_camera(request_, centre, radius);
     let mut params = btf::render::RenderParams::default();
     params.uv_scale = glam::Vec2::splat(request_.uv_scale);
+    if !request_.parts.is_empty() {
+        return super::btf_parts::run_parts(request_, gpu, &pca, &object, &camera, &params);
+    }
     let Some(light) = one_light(&request_.light, request_.radiance) else {
         let Some(lighting) = request_.light.env_lighting() else {
             return Err(request(&request_.out, "no light to render with".to_owned()));
@@ -351,7 +357,7 @@ pub fn run_render(
 }
 
 /// The point or directional light of `light` (`None` for an environment).
-fn one_light(light: &RenderLight, radiance: Vec3) -> Option<btf::render::Light> {
+pub(super) fn one_light(light: &RenderLight, radiance: Vec3) -> Option<btf::render::Light> {
     match *light {
         RenderLight::Direction(d) => Some(btf::render::Light::Directional {
             dir_to_light_world: d,
@@ -583,6 +589,10 @@ pub struct RenderArgs {
     /// Hide the progress bar over frames.
     #[arg(long)]
     quiet: bool,
+    /// A garment part (§5.6): faces of material NAME (OBJ usemtl, glTF material name) wear
+    /// FILE.btfpca, the other faces --btf; repeat for several parts (GPU).
+    #[arg(long = "part", value_name = "NAME=FILE.btfpca", value_parser = super::parse::named_path, conflicts_with_all = ["frames", "fins", "beside_plain", "cpu"])]
+    parts: Vec<(String, PathBuf)>,
     /// Output: IMAGE.png (a folder with --frames).
     #[arg(long)]
     out: PathBuf,
@@ -640,6 +650,7 @@ impl RenderArgs {
                 beside_without: self.beside_no_fins,
             }),
             frames: self.frames,
+            parts: self.parts,
             out: self.out,
             progress: !self.quiet,
         };

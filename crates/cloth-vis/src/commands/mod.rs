@@ -6,6 +6,7 @@ pub mod anim;
 pub mod bake;
 pub mod btf;
 pub mod btf_fins;
+mod btf_parts;
 pub mod btf_render;
 pub mod cpca;
 mod cpca_bits;

@@ -29,6 +29,18 @@ pub fn two_counts(text: &str) -> Result<(usize, usize), String> {
     Ok((count(a)?, count(e)?))
 }
 
+/// Parse `NAME=PATH` (e.g. `--part sleeve=silk.btfpca`); NAME may not be empty.
+pub fn named_path(text: &str) -> Result<(String, std::path::PathBuf), String> {
+    match text.split_once('=') {
+        Some((name, path)) if !name.is_empty() && !path.is_empty() => {
+            Ok((name.to_owned(), std::path::PathBuf::from(path)))
+        }
+        _ => Err(format!(
+            "{text:?} is not NAME=FILE (e.g. sleeve=silk.btfpca)"
+        )),
+    }
+}
+
 /// Parse `X,Y,Z` (finite).
 pub fn vec3(text: &str) -> Result<glam::Vec3, String> {
     let parts: Vec<&str> = text.split(',').collect();

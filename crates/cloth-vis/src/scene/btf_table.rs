@@ -51,6 +51,11 @@ pub struct BtfDesc {
     /// thesis's path) instead of M; static objects only.
     #[serde(default)]
     pub maps: Option<u32>,
+    /// Garment parts (§5.6): face material NAME (OBJ `usemtl`, glTF material) of the BTF
+    /// objects loaded from files wears this BTF (`synth:woven` or a `.btfpca` relative to the
+    /// scene); other faces wear `source`.
+    #[serde(default)]
+    pub parts: std::collections::BTreeMap<String, String>,
 }
 
 /// How the BTF objects are lit.
@@ -119,6 +124,7 @@ impl Default for BtfDesc {
             illumination: BtfIllumination::Light,
             level: default_btf_level(),
             maps: None,
+            parts: std::collections::BTreeMap::new(),
         }
     }
 }
@@ -132,6 +138,20 @@ impl Scene {
                 return Err(
                     self.invalid("btf.source", format!("{} does not exist", path.display()))
                 );
+            }
+        }
+        for (name, source) in &b.parts {
+            let key = format!("btf.parts.{name}");
+            if let BtfSource::File(path) = self.material_source(&key, source)? {
+                if !path.is_file() {
+                    return Err(self.invalid(
+                        &key,
+                        format!(
+                            "{} is not a file; give a .btfpca or \"synth:woven\"",
+                            path.display()
+                        ),
+                    ));
+                }
             }
         }
         if let Some(name) = b
@@ -210,7 +230,10 @@ impl Scene {
                     format!("{} is outside 0..={}", b.level, super::MAX_LEVEL),
                 ));
             }
-            if let Some(res) = b.maps.filter(|r| !(2..=256).contains(r) || !r.is_multiple_of(2)) {
+            if let Some(res) = b
+                .maps
+                .filter(|r| !(2..=256).contains(r) || !r.is_multiple_of(2))
+            {
                 return Err(self.invalid(
                     "btf.maps",
                     format!("{res} must be even and within 2..=256 (hemicube pixels per side)"),

@@ -486,13 +486,21 @@ impl Scene {
     /// # Errors
     /// [`Error::Scene`] for an unknown `synth:` name.
     pub fn btf_source(&self) -> Result<BtfSource, Error> {
-        match self.btf.source.strip_prefix(SYNTH_PREFIX) {
+        self.material_source("btf.source", &self.btf.source)
+    }
+
+    /// Resolve a BTF named in the scene under `key` (`btf.source`, `btf.parts.NAME`).
+    ///
+    /// # Errors
+    /// [`Error::Scene`] naming `key` for an unknown `synth:` name.
+    pub fn material_source(&self, key: &str, source: &str) -> Result<BtfSource, Error> {
+        match source.strip_prefix(SYNTH_PREFIX) {
             Some("woven") => Ok(BtfSource::SynthWoven),
             Some(other) => Err(self.invalid(
-                "btf.source",
+                key,
                 format!("unknown procedural source \"synth:{other}\"; known: synth:woven"),
             )),
-            None => Ok(BtfSource::File(self.base_dir.join(&self.btf.source))),
+            None => Ok(BtfSource::File(self.base_dir.join(source))),
         }
     }
 
