@@ -597,3 +597,65 @@ fn parts_wear_their_own_btf_and_the_rest_is_untouched() {
     assert!(!out.status.success(), "{}", stderr(&out));
     assert!(!bad.exists());
 }
+
+/// `btf render --frames` on a real skinned clip (CesiumMan, 3,273 vertices): each frame its own
+/// visibility under the environment; a static mesh is refused.
+#[test]
+fn frames_of_a_gltf_clip_under_an_environment() {
+    let Some(clip) = test_data::shared_file("anim/gltf/CesiumMan.glb") else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let btf_file = woven_btf(tmp.path(), "8");
+    let dir = tmp.path().join("walk");
+    let out = cli(&[
+        "btf",
+        "render",
+        text(&clip),
+        "--btf",
+        text(&btf_file),
+        "--sky",
+        "--level",
+        "1",
+        "--frames",
+        "3..5",
+        "--cpu",
+        "--size",
+        "32x48",
+        "--quiet",
+        "--out",
+        text(&dir),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("3273 vertices"), "{}", stdout(&out));
+    let a = image::open(dir.join("frame-0003.png")).unwrap().to_rgb8();
+    let b = image::open(dir.join("frame-0004.png")).unwrap().to_rgb8();
+    assert!(a.pixels().filter(|p| p.0 != [0, 0, 0]).count() > 40);
+    assert_ne!(a, b, "the walk moves between frames");
+    let obj = tmp.path().join("tri.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let bad = tmp.path().join("bad");
+    let out = cli(&[
+        "btf",
+        "render",
+        text(&obj),
+        "--btf",
+        text(&btf_file),
+        "--sky",
+        "--frames",
+        "0..1",
+        "--cpu",
+        "--out",
+        text(&bad),
+    ]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("1 frame"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!bad.exists());
+}

@@ -181,3 +181,56 @@ fn maps_and_the_visibility_matrix_give_the_same_w_within_their_discretisation() 
     );
     assert!(errors[2].0 < 0.03 && errors[2].1 < 0.012, "{errors:?}");
 }
+
+/// Hard case: a vertex whose every map pixel is occluded (a floor shut in a box) bins nothing —
+/// W = 0 exactly, so the BTF renders black, not NaN.
+#[test]
+fn a_vertex_with_every_pixel_occluded_bins_nothing() {
+    let s = 1.5;
+    let walls = [
+        // roof (normal down), four walls facing in
+        sheet(
+            Vec3::new(-s, 1.0, -s),
+            Vec3::new(2.0 * s, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 2.0 * s),
+            2,
+        ),
+        sheet(
+            Vec3::new(-s, -0.1, -s),
+            Vec3::new(0.0, 1.2, 0.0),
+            Vec3::new(0.0, 0.0, 2.0 * s),
+            2,
+        ),
+        sheet(
+            Vec3::new(s, -0.1, -s),
+            Vec3::new(0.0, 0.0, 2.0 * s),
+            Vec3::new(0.0, 1.2, 0.0),
+            2,
+        ),
+        sheet(
+            Vec3::new(-s, -0.1, -s),
+            Vec3::new(2.0 * s, 0.0, 0.0),
+            Vec3::new(0.0, 1.2, 0.0),
+            2,
+        ),
+        sheet(
+            Vec3::new(-s, -0.1, s),
+            Vec3::new(0.0, 1.2, 0.0),
+            Vec3::new(2.0 * s, 0.0, 0.0),
+            2,
+        ),
+    ];
+    let shut = scene(floor(2.0, 2), &walls);
+    let (maps, frames) = maps_in_tangent_frames(&shut, Model::Hemicube { res: 16 });
+    assert!(
+        maps.open_fraction().iter().all(|&f| f == 0.0),
+        "the box is closed"
+    );
+    let channel = BtfLightChannel::new(maps.layout(), Sampling::H1);
+    let mirrored: Vec<bool> = frames.iter().map(|f| f.1).collect();
+    let w = channel.light_weights(&maps, &mirrored, |_| Vec3::splat(1e4));
+    assert!(w.iter().all(|x| x.weights.iter().all(|v| *v == Vec3::ZERO)));
+    let (pca, _) = btf_env_common::lambertian(Sampling::H1);
+    let rgb = pca.eval_env(Vec3::Z, &w[0], 0.3, 0.3);
+    assert_eq!(rgb, [0.0; 3]);
+}

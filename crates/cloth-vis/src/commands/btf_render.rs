@@ -404,20 +404,56 @@ fn run_frames(
     pca: &BtfPca,
     (start, end): (usize, usize),
 ) -> Result<RenderSummary, Error> {
-    if request_.mesh != Path::new("synth:cloth") {
+    // The drape, or an animation file (a glTF clip, an OBJ folder, a point cache with its
+    // topology is not offered here) with one UV per vertex.
+    let (triangles, frames_all, uvs) = if request_.mesh == Path::new("synth:cloth") {
+        let anim = synth::simulate_cloth(&synth::ClothParams::default())?;
+        (anim.triangles, anim.frames, anim.uvs)
+    } else if request_
+        .mesh
+        .to_str()
+        .is_some_and(|m| m.starts_with("synth:"))
+    {
         return Err(request(
             &request_.mesh,
-            "--frames needs an animated input; the one built in is synth:cloth".to_owned(),
+            "--frames needs an animated input: synth:cloth or an animation file (.glb/.gltf \
+             clip, folder of .obj frames)"
+                .to_owned(),
+        ));
+    } else {
+        let (anim, _) =
+            meshio::load_animation(&request_.mesh, &meshio::AnimationOptions::default())?;
+        let uvs = anim.uvs.ok_or_else(|| {
+            request(
+                &request_.mesh,
+                "has no per-vertex texture coordinates, and a BTF is looked up by them".to_owned(),
+            )
+        })?;
+        (anim.triangles, anim.frames, uvs)
+    };
+    let total = frames_all.len();
+    if total < 2 {
+        return Err(request(
+            &request_.mesh,
+            format!("--frames needs an animated input; this one has {total} frame"),
         ));
     }
-    let anim = synth::simulate_cloth(&synth::ClothParams::default())?;
-    let total = anim.frames.len();
     if start >= end || end > total {
         return Err(request(
             &request_.out,
-            format!("--frames {start}..{end} is outside the drape's {total} frames (0..{total})"),
+            format!("--frames {start}..{end} is outside the input's {total} frames (0..{total})"),
         ));
     }
+    struct Frames {
+        triangles: Vec<[u32; 3]>,
+        frames: Vec<Vec<Vec3>>,
+        uvs: Vec<glam::Vec2>,
+    }
+    let anim = Frames {
+        triangles,
+        frames: frames_all,
+        uvs,
+    };
     let existing = super::folder_output(&request_.out, false)?;
     let (centre, radius) = render::bounding_sphere(anim.frames[start..end].iter().flatten())
         .unwrap_or((Vec3::ZERO, 1.0));
@@ -438,7 +474,7 @@ fn run_frames(
                 meshio::NormalWeighting::Angle,
             );
             let object = cloth_vis::object::WorldObject::textured(
-                format!("synth:cloth frame {f}"),
+                format!("{} frame {f}", request_.mesh.display()),
                 positions,
                 normals,
                 anim.triangles.clone(),
@@ -490,7 +526,10 @@ fn run_frames(
     bar.finish_and_clear();
     let n = (end - start) as f64;
     Ok(RenderSummary {
-        mesh: (anim.vertex_count(), anim.triangles.len()),
+        mesh: (
+            anim.frames.first().map_or(0, Vec::len),
+            anim.triangles.len(),
+        ),
         size,
         backend: if gpu.is_some() { "gpu" } else { "cpu" },
         seconds: begin.elapsed().as_secs_f64(),
