@@ -10,11 +10,15 @@
 //! - `gamma_star_4_slots`: γ* of the four view slots of every vertex from W (eq. 5.11).
 //!
 //! An environment update is `update_w` + `gamma_star_4_slots`.
+//!
+//! The decomposition of eq. 5.13 on the same vertices, A = 30 turns (12°) of a coloured sky
+//! with a sun: `decompose_build_centred` / `_uncentred` (the PCA, once per environment) and
+//! `decompose_turn_e5` (W at any turn from 5 components: the runtime cost of a rotation).
 
 use std::hint::black_box;
 use std::time::Duration;
 
-use btf::env::{EnvLightWeights, EnvTransfer};
+use btf::env::{EnvDecomposition, EnvLightWeights, EnvTransfer};
 use btf::{BtfPca, BtfPcaParams, DIRECTIONS, Sampling, ViewSlot};
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::Vec3;
@@ -111,6 +115,37 @@ fn bench_env(c: &mut Criterion) {
                 );
             black_box(&gammas);
         })
+    });
+    let turns = 30;
+    let samples: Vec<Vec<EnvLightWeights>> = (0..turns)
+        .map(|a| {
+            let (sin, cos) = (std::f32::consts::TAU * a as f32 / turns as f32).sin_cos();
+            let sun = Vec3::new(0.6 * cos, 0.5, 0.6 * sin).normalize();
+            let turned: Vec<Vec3> = dirs
+                .iter()
+                .map(|d| {
+                    Vec3::new(1.0 + d.y, 0.8, 0.6 + d.x * cos - d.z * sin)
+                        + Vec3::splat(40.0 * d.dot(sun).max(0.0).powi(32))
+                })
+                .collect();
+            let mut out = Vec::new();
+            transfer.update(&turned, &mut out);
+            out
+        })
+        .collect();
+    for centred in [true, false] {
+        let name = if centred {
+            "decompose_build_centred"
+        } else {
+            "decompose_build_uncentred"
+        };
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(EnvDecomposition::build(&samples, 5, centred).unwrap()))
+        });
+    }
+    let dec = EnvDecomposition::build(&samples, 5, true).unwrap();
+    group.bench_function("decompose_turn_e5", |b| {
+        b.iter(|| dec.weights_at(black_box(0.37), &mut w))
     });
     group.finish();
 }

@@ -11,20 +11,22 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use btf::BtfPca;
-use btf::render::{GpuBtfRenderer, Light, RenderParams};
+use btf::render::{Light, RenderParams};
 use glam::{Vec2, Vec3};
 use gpu_context::{GpuContext, HdrImage};
 use render::{FramePass, Renderer};
 use serde_json::json;
 
 use crate::Error;
-use crate::btf_stage::{Lit, btf_mesh, material_part, plain_material, synth_material, tangents_of};
+use crate::btf_stage::{
+    Lit, material_part, plain_material, render_items, synth_material, tangents_of,
+};
 use crate::object::WorldObject;
 use crate::run::Look;
 use crate::scene::Scene;
 
-/// One frame of the scene: each item an object (or a part of one) with its BTF (a
-/// [`btf::render::BtfDraw`] each), the Gouraud pass drawing the rest.
+/// One frame of the scene: the items (objects or parts, each with its BTF), the Gouraud pass
+/// drawing the rest, the fins when given.
 fn scene_frame(
     gpu: &GpuContext,
     renderer: &mut Renderer,
@@ -34,40 +36,19 @@ fn scene_frame(
     params: &RenderParams,
     fins: Option<&crate::fins_stage::FinFrame>,
 ) -> Result<HdrImage, Error> {
-    let frames = items
-        .iter()
-        .map(|(_, o)| tangents_of(o))
-        .collect::<Result<Vec<_>, _>>()?;
-    let btfs = items
-        .iter()
-        .map(|(pca, _)| {
-            GpuBtfRenderer::for_frame(&gpu.device, &gpu.queue, pca, &renderer.pass_context())
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let draws = items
-        .iter()
-        .zip(&frames)
-        .zip(&btfs)
-        .enumerate()
-        .map(|(i, (((_, o), (t, uv)), btf))| {
-            let mesh = btf_mesh(o, t, uv);
-            match light {
-                Lit::Light(l) => btf.prepare(&mesh, l, &look.camera, params),
-                Lit::Environment(w) => btf.prepare_env(&mesh, &w[i], &look.camera, params),
-            }
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
-    if let Some(f) = fins {
-        passes.extend(f.draws.iter().map(|d| d as &dyn FramePass));
-    }
-    Ok(renderer.render(
-        &gpu.device,
-        &gpu.queue,
+    let extra: Vec<&dyn FramePass> = fins
+        .map(|f| f.draws.iter().map(|d| d as &dyn FramePass).collect())
+        .unwrap_or_default();
+    render_items(
+        gpu,
+        renderer,
+        items,
+        light,
         &look.camera,
         look.background,
-        &passes,
-    )?)
+        params,
+        &extra,
+    )
 }
 
 /// A BTF named in a scene: `synth:woven` or a file relative to the scene.

@@ -327,17 +327,46 @@ pub fn render_parts(
     params: &RenderParams,
 ) -> Result<HdrImage, Error> {
     let mut renderer = Renderer::new(&gpu.device, FrameFormat::single_sample(&gpu.device));
-    let frames = parts
+    let background = Background::Color(params.background.to_array());
+    render_items(
+        gpu,
+        &mut renderer,
+        parts,
+        lit,
+        camera,
+        background,
+        params,
+        &[],
+    )
+}
+
+/// One frame of `renderer`: each item an object (or a part of one) with its BTF, a
+/// [`btf::render::BtfDraw`] each, then `extra` passes (fins), under `lit`.
+///
+/// # Errors
+/// An item without UVs; renderer errors.
+#[allow(clippy::too_many_arguments)] // one frame's inputs; a struct would only rename them
+pub(crate) fn render_items(
+    gpu: &GpuContext,
+    renderer: &mut Renderer,
+    items: &[(&BtfPca, &WorldObject)],
+    lit: &Lit,
+    camera: &Camera,
+    background: Background,
+    params: &RenderParams,
+    extra: &[&dyn FramePass],
+) -> Result<HdrImage, Error> {
+    let frames = items
         .iter()
         .map(|(_, o)| tangents_of(o))
         .collect::<Result<Vec<_>, _>>()?;
-    let btfs = parts
+    let btfs = items
         .iter()
         .map(|(pca, _)| {
             GpuBtfRenderer::for_frame(&gpu.device, &gpu.queue, pca, &renderer.pass_context())
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let draws = parts
+    let draws = items
         .iter()
         .zip(&frames)
         .zip(&btfs)
@@ -350,8 +379,8 @@ pub fn render_parts(
             }
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
-    let background = Background::Color(params.background.to_array());
+    let mut passes: Vec<&dyn FramePass> = draws.iter().map(|d| d as &dyn FramePass).collect();
+    passes.extend_from_slice(extra);
     Ok(renderer.render(&gpu.device, &gpu.queue, camera, background, &passes)?)
 }
 

@@ -466,35 +466,6 @@ fn maps_and_the_decomposition_from_the_cli() {
     }
 }
 
-/// An OBJ sheet facing +z in an n × n grid with UVs: triangles left of x = 0.5 under
-/// `usemtl left`, the rest under `usemtl right`.
-fn two_part_sheet(n: usize) -> String {
-    let mut obj = String::new();
-    for r in 0..=n {
-        for c in 0..=n {
-            let (x, y) = (c as f32 / n as f32, r as f32 / n as f32);
-            obj.push_str(&format!("v {x} {y} 0\nvt {x} {y}\n"));
-        }
-    }
-    for (material, cols) in [("left", 0..n / 2), ("right", n / 2..n)] {
-        obj.push_str(&format!("usemtl {material}\n"));
-        for r in 0..n {
-            for c in cols.clone() {
-                let i = r * (n + 1) + c + 1;
-                let j = i + n + 1;
-                obj.push_str(&format!(
-                    "f {i}/{i} {}/{} {}/{} {j}/{j}\n",
-                    i + 1,
-                    i + 1,
-                    j + 1,
-                    j + 1
-                ));
-            }
-        }
-    }
-    obj
-}
-
 /// `btf render --part NAME=FILE` (garment parts, §5.6): the faces of material NAME wear FILE,
 /// every other face keeps --btf — pixel for pixel against the single-material render.
 #[test]
@@ -519,7 +490,7 @@ fn parts_wear_their_own_btf_and_the_rest_is_untouched() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let mesh = tmp.path().join("sheet.obj");
-    std::fs::write(&mesh, two_part_sheet(16)).unwrap();
+    std::fs::write(&mesh, common::two_part_sheet(16)).unwrap();
     let render = |extra: &[&str], png: &Path| {
         let mut args = vec![
             "btf",

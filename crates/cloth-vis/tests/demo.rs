@@ -292,31 +292,7 @@ fn scene_parts_dress_each_face_material_in_its_own_btf() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let n = 12;
-    let mut obj = String::new();
-    for r in 0..=n {
-        for c in 0..=n {
-            let (x, y) = (c as f32 / n as f32, r as f32 / n as f32);
-            obj.push_str(&format!("v {x} {y} 0\nvt {x} {y}\n"));
-        }
-    }
-    for (material, cols) in [("left", 0..n / 2), ("right", n / 2..n)] {
-        obj.push_str(&format!("usemtl {material}\n"));
-        for r in 0..n {
-            for c in cols.clone() {
-                let i = r * (n + 1) + c + 1;
-                let j = i + n + 1;
-                obj.push_str(&format!(
-                    "f {i}/{i} {}/{} {}/{} {j}/{j}\n",
-                    i + 1,
-                    i + 1,
-                    j + 1,
-                    j + 1
-                ));
-            }
-        }
-    }
-    std::fs::write(dir.path().join("sheet.obj"), obj).unwrap();
+    std::fs::write(dir.path().join("sheet.obj"), common::two_part_sheet(12)).unwrap();
     cloth_vis::btf_stage::synth_material(8, 1)
         .unwrap()
         .write(&dir.path().join("flat.btfpca"))

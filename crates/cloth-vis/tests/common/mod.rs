@@ -91,3 +91,32 @@ pub fn object(
         animation: None,
     }
 }
+
+/// An OBJ sheet facing +z in an n × n grid with UVs: triangles left of x = 0.5 under
+/// `usemtl left`, the rest under `usemtl right`.
+pub fn two_part_sheet(n: usize) -> String {
+    let mut obj = String::new();
+    for r in 0..=n {
+        for c in 0..=n {
+            let (x, y) = (c as f32 / n as f32, r as f32 / n as f32);
+            obj.push_str(&format!("v {x} {y} 0\nvt {x} {y}\n"));
+        }
+    }
+    for (material, cols) in [("left", 0..n / 2), ("right", n / 2..n)] {
+        obj.push_str(&format!("usemtl {material}\n"));
+        for r in 0..n {
+            for c in cols.clone() {
+                let i = r * (n + 1) + c + 1;
+                let j = i + n + 1;
+                obj.push_str(&format!(
+                    "f {i}/{i} {}/{} {}/{} {j}/{j}\n",
+                    i + 1,
+                    i + 1,
+                    j + 1,
+                    j + 1
+                ));
+            }
+        }
+    }
+    obj
+}
