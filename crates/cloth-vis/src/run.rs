@@ -252,6 +252,12 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                 })?
             }
             Some(range) => {
+                // The btf stage follows the sequence: btf-NNNN.png per frame, materials once.
+                let btf = if plan.contains(Stage::Btf) {
+                    Some(crate::btf_scene::BtfScene::load(scene, &renderer, &gpu)?)
+                } else {
+                    None
+                };
                 let (image, written) = render_sequence(
                     scene,
                     tmp,
@@ -262,6 +268,7 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
                     &mut renderer,
                     &mut objects,
                     lights.as_ref(),
+                    btf.as_ref().map(|b| (b, environment.as_ref())),
                     &look,
                     range,
                     options.progress,
@@ -272,7 +279,7 @@ pub fn run_scene(scene: &Scene, out_dir: &Path, options: &RunOptions) -> Result<
             }
         };
 
-        if plan.contains(Stage::Btf) {
+        if plan.contains(Stage::Btf) && frames.is_none() {
             let written = timer.run(Stage::Btf, || {
                 crate::btf_scene::run(
                     scene,
@@ -685,6 +692,10 @@ fn render_sequence(
     renderer: &mut Renderer,
     objects: &mut [WorldObject],
     lights: Option<&Lights>,
+    btf: Option<(
+        &crate::btf_scene::BtfScene,
+        Option<&lightsphere::Environment>,
+    )>,
     look: &Look,
     range: FrameRange,
     progress: bool,
@@ -693,6 +704,7 @@ fn render_sequence(
     let bar = progress_bar(progress, range.len() as u64, "rendering frames");
     let (mut pose_t, mut vis_t, mut light_t, mut render_t, mut write_t) = Default::default();
     let mut static_t = FrameTimes::default();
+    let (mut btf_t, mut btf_params) = (FrameTimes::default(), json!({}));
     let (mut vis_params, mut light_params, mut static_params) = (json!({}), json!({}), json!({}));
     let mut effect_t: Vec<(Stage, FrameTimes, serde_json::Value)> = Vec::new();
     let mut display: Option<Display> = None;
@@ -760,10 +772,19 @@ fn render_sequence(
         written.extend(write_images(&image, &d, look.background, png, exr)?);
         FrameTimes::add(&mut write_t, ms_since(t));
         last = Some(image);
+        if let Some((stage, env)) = btf {
+            let t = Instant::now();
+            let png = frame_file_name("btf", f, "png");
+            let (files, params) =
+                stage.frame(scene, out_dir, &png, gpu, renderer, objects, look, env)?;
+            written.extend(files);
+            FrameTimes::add(&mut btf_t, ms_since(t));
+            btf_params = params;
+        }
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let times: [(Stage, &FrameTimes, serde_json::Value); 5] = [
+    let times: [(Stage, &FrameTimes, serde_json::Value); 6] = [
         (
             Stage::Geometry,
             &pose_t,
@@ -786,6 +807,7 @@ fn render_sequence(
                 "write_mean_ms_per_frame": write_t.total_ms / write_t.frames.max(1) as f64,
             }),
         ),
+        (Stage::Btf, &btf_t, btf_params),
     ];
     let effect_times = effect_t.iter().map(|(s, t, p)| (*s, t, p.clone()));
     for (stage, t, params) in times.into_iter().chain(effect_times) {

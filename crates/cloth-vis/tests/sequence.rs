@@ -256,3 +256,44 @@ fn bad_frame_ranges_are_refused_naming_the_key() {
     let err = run_scene(&still, dir.path(), &RunOptions::default()).unwrap_err();
     assert!(err.to_string().contains("no object is animated"), "{err}");
 }
+
+/// The btf effect follows a sequence: btf-NNNN.png per frame, the garment lit by the scene's
+/// environment through that frame's own visibility, and the stage timed per frame.
+#[test]
+fn the_btf_stage_follows_a_sequence_under_the_environment() {
+    if !common::gpu_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let text = SCENE.replace(
+        "effects = [\"lighting\", \"self-shadowing\"]",
+        "effects = [\"btf\"]",
+    ) + "\n[btf]\nres = 8\nillumination = \"environment\"\nlevel = 1\nobjects = [\"cloth\"]\n";
+    let scene = common::scene(&text, std::path::Path::new("."));
+    let options = RunOptions {
+        frames: Some("2..5".parse::<FrameRange>().unwrap()),
+        ..RunOptions::default()
+    };
+    let output = run_scene(&scene, dir.path(), &options).unwrap();
+    let frames: Vec<_> = (2..5)
+        .map(|f| {
+            image::open(dir.path().join(format!("btf-{f:04}.png")))
+                .unwrap()
+                .to_rgb8()
+        })
+        .collect();
+    assert_eq!(frames[0].dimensions(), (2 * 96, 80));
+    assert_ne!(frames[0], frames[2], "the cloth falls between frames 2 and 4");
+    assert!(!dir.path().join("btf.png").exists(), "no still beside the sequence");
+    let stage = output
+        .report
+        .stages
+        .iter()
+        .find(|s| s.stage == "btf")
+        .expect("a btf stage record");
+    assert_eq!(stage.params["frames"], 3, "{:?}", stage.params);
+    assert_eq!(
+        stage.params["illumination"]["visibility"],
+        "M at lightsphere level 1"
+    );
+}
