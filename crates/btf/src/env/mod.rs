@@ -28,6 +28,10 @@
 //! γ* is RGB because the environment is coloured; the point-light path's γ is one number
 //! per coefficient times the light's colour g.
 //!
+//! Turning the environment (eq. 5.13): [`decompose`] keeps W of every vertex for A turns as a
+//! mean and e PCA components, so any turn costs an e-term sum per vertex. W can also come from
+//! static visibility maps (crate `hemicube`, `BtfLightChannel`) instead of M.
+//!
 //! ```
 //! use btf::env::EnvLightWeights;
 //! use btf::{BtfPca, BtfPcaParams, Sampling, ViewSlot};
@@ -51,7 +55,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-mod decompose;
+pub mod decompose;
 pub use decompose::{EnvDecomposition, relative_error};
 
 use crate::model::BtfPca;
