@@ -121,16 +121,7 @@ pub fn run(out: &Path) -> anyhow::Result<()> {
         } else {
             Vec3::new(0.55, 0.45, 1.0)
         };
-        let desc = cloth_vis::scene::CameraDesc {
-            width: 512,
-            height: 512,
-            direction: direction.to_array(),
-            up: up.to_array(),
-            ..Default::default()
-        };
-        let framed = cloth_vis::camera::resolve(&desc, centre, radius);
-        let camera =
-            render::Camera::look_at(framed.eye, framed.target, *up, desc.fov_deg, 512, 512);
+        let camera = cloth_vis::camera::frame_sphere(direction, *up, centre, radius, 512, 512);
         let light = Light::Directional {
             dir_to_light_world: *up + Vec3::new(0.3, 0.3, 0.3),
             radiance: Vec3::ONE,

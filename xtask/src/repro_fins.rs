@@ -225,15 +225,7 @@ fn pictures(md: &mut String, out: &Path, gpu: &gpu_context::GpuContext) -> anyho
         } else {
             Vec3::new(0.2, 0.7, 0.7)
         };
-        let desc = cloth_vis::scene::CameraDesc {
-            width: 480,
-            height: 480,
-            direction: direction.to_array(),
-            up: up.to_array(),
-            ..Default::default()
-        };
-        let framed = cloth_vis::camera::resolve(&desc, centre, radius);
-        let camera = render::Camera::look_at(framed.eye, framed.target, up, desc.fov_deg, 480, 480);
+        let camera = cloth_vis::camera::frame_sphere(direction, up, centre, radius, 480, 480);
         let light = Light::Directional {
             dir_to_light_world: light_dir,
             radiance: Vec3::splat(1.3),

@@ -35,6 +35,27 @@ pub fn resolve(desc: &CameraDesc, centre: Vec3, radius: f32) -> Camera {
     }
 }
 
+/// A `width × height` camera looking at the sphere (`centre`, `radius`) from `direction`
+/// (towards the camera) with `up`, the default field of view, the sphere framed and enclosed
+/// by the near and far planes — the framing of the CLI's pictures and the repro figures.
+pub fn frame_sphere(
+    direction: Vec3,
+    up: Vec3,
+    centre: Vec3,
+    radius: f32,
+    width: u32,
+    height: u32,
+) -> Camera {
+    let desc = CameraDesc {
+        width,
+        height,
+        direction: direction.to_array(),
+        up: up.to_array(),
+        ..CameraDesc::default()
+    };
+    resolve(&desc, centre, radius)
+}
+
 /// The `[camera]` values no framing can fix, refused before any work as `(TOML key, problem)`:
 /// non-finite or zero vectors, an eye on its target, an up vector along the view direction
 /// (which the renderer would only find after every stage ran).

@@ -17,6 +17,37 @@ fn small_demo() -> Scene {
     scene
 }
 
+/// The cloth of the small demo alone on black at a fixed exposure with only the btf effect.
+fn btf_only_cloth() -> Scene {
+    let mut scene = small_demo();
+    scene.objects.retain(|o| o.name == "cloth");
+    scene.ground = None;
+    scene.output.background = cloth_vis::scene::BackgroundDesc::BLACK;
+    scene.output.exposure = cloth_vis::scene::ExposureDesc::Fixed(0.0);
+    scene.effects = vec!["btf".to_owned()];
+    scene
+}
+
+/// Runs `scene`; its btf.png and the btf stage's report record.
+fn run_btf(scene: &Scene) -> (image::RgbImage, serde_json::Value) {
+    let dir = tempfile::tempdir().unwrap();
+    run_scene(scene, dir.path(), &RunOptions::default()).unwrap();
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("run-report.json")).unwrap())
+            .unwrap();
+    let stage = json["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["stage"] == "btf")
+        .unwrap()
+        .clone();
+    (
+        image::open(dir.path().join("btf.png")).unwrap().to_rgb8(),
+        stage,
+    )
+}
+
 #[test]
 fn demo_writes_non_constant_png_exr_and_a_report_of_the_planned_stages() {
     if !gpu_available() {
@@ -136,14 +167,8 @@ fn fins_from_the_scene_fringe_the_btf_half_only() {
         return;
     }
     let run = |fins: bool| {
-        let dir = tempfile::tempdir().unwrap();
-        let mut scene = small_demo();
-        scene.objects.retain(|o| o.name == "cloth");
-        scene.ground = None;
-        scene.output.background = cloth_vis::scene::BackgroundDesc::BLACK;
-        scene.effects = vec!["btf".to_owned()];
         // One exposure for both runs: fins add light to the pixels automatic exposure reads.
-        scene.output.exposure = cloth_vis::scene::ExposureDesc::Fixed(0.0);
+        let mut scene = btf_only_cloth();
         if fins {
             scene.btf.fins = Some(cloth_vis::scene::FinsDesc {
                 source: "synth:wool".to_owned(),
@@ -151,19 +176,7 @@ fn fins_from_the_scene_fringe_the_btf_half_only() {
                 size: None,
             });
         }
-        run_scene(&scene, dir.path(), &RunOptions::default()).unwrap();
-        let json: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(dir.path().join("run-report.json")).unwrap())
-                .unwrap();
-        let btf_stage = json["stages"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|s| s["stage"] == "btf")
-            .unwrap()
-            .clone();
-        let png = image::open(dir.path().join("btf.png")).unwrap().to_rgb8();
-        (png, btf_stage)
+        run_btf(&scene)
     };
     let (plain, _) = run(false);
     let (fringed, stage) = run(true);
@@ -218,30 +231,10 @@ fn a_scene_lights_the_btf_by_its_environment_and_maps_agree_with_m() {
     }
     use cloth_vis::scene::BtfIllumination;
     let run = |illumination: BtfIllumination, maps: Option<u32>| {
-        let dir = tempfile::tempdir().unwrap();
-        let mut scene = small_demo();
-        scene.objects.retain(|o| o.name == "cloth");
-        scene.ground = None;
-        scene.output.background = cloth_vis::scene::BackgroundDesc::BLACK;
-        scene.output.exposure = cloth_vis::scene::ExposureDesc::Fixed(0.0);
-        scene.effects = vec!["btf".to_owned()];
+        let mut scene = btf_only_cloth();
         scene.btf.illumination = illumination;
         scene.btf.maps = maps;
-        run_scene(&scene, dir.path(), &RunOptions::default()).unwrap();
-        let json: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(dir.path().join("run-report.json")).unwrap())
-                .unwrap();
-        let stage = json["stages"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|s| s["stage"] == "btf")
-            .unwrap()
-            .clone();
-        (
-            image::open(dir.path().join("btf.png")).unwrap().to_rgb8(),
-            stage,
-        )
+        run_btf(&scene)
     };
     let (light, _) = run(BtfIllumination::Light, None);
     let (by_m, stage) = run(BtfIllumination::Environment, None);

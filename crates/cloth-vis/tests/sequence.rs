@@ -283,8 +283,14 @@ fn the_btf_stage_follows_a_sequence_under_the_environment() {
         })
         .collect();
     assert_eq!(frames[0].dimensions(), (2 * 96, 80));
-    assert_ne!(frames[0], frames[2], "the cloth falls between frames 2 and 4");
-    assert!(!dir.path().join("btf.png").exists(), "no still beside the sequence");
+    assert_ne!(
+        frames[0], frames[2],
+        "the cloth falls between frames 2 and 4"
+    );
+    assert!(
+        !dir.path().join("btf.png").exists(),
+        "no still beside the sequence"
+    );
     let stage = output
         .report
         .stages

@@ -376,19 +376,11 @@ pub(super) fn one_light(light: &RenderLight, radiance: Vec3) -> Option<btf::rend
 fn framing_camera(request_: &RenderRequest, centre: Vec3, radius: f32) -> render::Camera {
     let [w, h] = request_.size;
     let up = super::up_axis::up_axis_rotation(request_.up_axis).as_quat();
-    let desc = cloth_vis::scene::CameraDesc {
-        width: w,
-        height: h,
-        direction: (up * request_.camera_direction).to_array(),
-        up: (up * Vec3::Y).to_array(),
-        ..cloth_vis::scene::CameraDesc::default()
-    };
-    let framed = cloth_vis::camera::resolve(&desc, centre, radius);
-    render::Camera::look_at(
-        framed.eye,
-        framed.target,
-        Vec3::from(desc.up),
-        desc.fov_deg,
+    cloth_vis::camera::frame_sphere(
+        up * request_.camera_direction,
+        up * Vec3::Y,
+        centre,
+        radius,
         w,
         h,
     )
