@@ -27,6 +27,16 @@ use crate::Error;
 use crate::btf_stage::{btf_mesh, tangents_of};
 use crate::object::WorldObject;
 
+/// Most turns a decomposition samples (1° apart).
+pub const MAX_TURNS: usize = 360;
+
+/// Most bytes the A samples of W may hold (A × vertices × 81 × 3 × 4 bytes, kept twice while
+/// the PCA runs): 2 GB, e.g. 30 turns of 70,000 vertices.
+pub const MAX_DECOMPOSITION_BYTES: u64 = 2_000_000_000;
+
+/// Bytes of W per vertex and turn, counted twice (the samples and their flattened copy).
+const BYTES_PER_VERTEX_TURN: u64 = 2 * 81 * 3 * 4;
+
 /// Whose visibility shadows the environment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum EnvVisibility {
@@ -245,6 +255,12 @@ impl<'a> EnvBinner<'a> {
     /// # Errors
     /// A non-finite angle; lightsphere errors.
     pub fn weights(&self, deg: f32) -> Result<Vec<EnvLightWeights>, Error> {
+        if !deg.is_finite() {
+            return Err(Error::Request {
+                path: std::path::PathBuf::from("rotation"),
+                message: format!("the environment's turn {deg}° must be finite"),
+            });
+        }
         (self.update)(deg)
     }
 
@@ -252,12 +268,29 @@ impl<'a> EnvBinner<'a> {
     /// with the milliseconds of the A updates and of the PCA.
     ///
     /// # Errors
-    /// As [`EnvBinner::weights`]; decomposition errors (A < 2).
+    /// As [`EnvBinner::weights`]; decomposition errors (A < 2); [`Error::Request`] for more
+    /// than [`MAX_TURNS`] turns or samples that would hold more than [`MAX_DECOMPOSITION_BYTES`].
     pub fn decompose(
         &self,
         d: Decompose,
         centred: bool,
     ) -> Result<(EnvDecomposition, f64, f64), Error> {
+        let bytes = (d.turns as u64)
+            .saturating_mul(self.cost.vertices as u64)
+            .saturating_mul(BYTES_PER_VERTEX_TURN);
+        if d.turns > MAX_TURNS || bytes > MAX_DECOMPOSITION_BYTES {
+            return Err(Error::Request {
+                path: std::path::PathBuf::from("decompose"),
+                message: format!(
+                    "{} turns of {} vertices need {:.1} GB of samples; at most {MAX_TURNS} turns \
+                     and {:.0} GB (the thesis: 30 turns)",
+                    d.turns,
+                    self.cost.vertices,
+                    bytes as f64 / 1e9,
+                    MAX_DECOMPOSITION_BYTES as f64 / 1e9
+                ),
+            });
+        }
         let start = Instant::now();
         let samples = (0..d.turns)
             .map(|a| self.weights(360.0 * a as f32 / d.turns as f32))

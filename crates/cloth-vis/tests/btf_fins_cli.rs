@@ -451,10 +451,12 @@ fn maps_and_the_decomposition_from_the_cli() {
     );
     assert!(line.contains("error against the direct update"), "{line}");
 
-    // Refused before any work: A = 1, a zero count, and --maps/--decompose with --frames.
+    // Refused: A = 1, a zero count, 10⁵ turns (memory), an odd map side, --decompose with
+    // --frames.
     let bad = tmp.path().join("bad.png");
     for (extra, needle) in [
         (&["--decompose", "1,1"][..], "turns"),
+        (&["--decompose", "100000,5"][..], "at most 360 turns"),
         (&["--decompose", "5,0"][..], "at least 1"),
         (&["--maps", "7"][..], "7"),
         (&["--decompose", "4,2", "--frames", "0..2"][..], "--frames"),
@@ -464,6 +466,27 @@ fn maps_and_the_decomposition_from_the_cli() {
         assert!(stderr(&out).contains(needle), "{extra:?}: {}", stderr(&out));
         assert!(!bad.exists(), "{extra:?} wrote a file");
     }
+    let out = cli(&[
+        "btf",
+        "render",
+        "synth:sphere",
+        "--btf",
+        text(&btf_file),
+        "--sky",
+        "--maps",
+        "8",
+        "--rotation",
+        "nan",
+        "--cpu",
+        "--out",
+        text(&bad),
+    ]);
+    assert!(
+        !out.status.success() && stderr(&out).contains("must be finite"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!bad.exists());
 }
 
 /// `btf render --part NAME=FILE` (garment parts, §5.6): the faces of material NAME wear FILE,
