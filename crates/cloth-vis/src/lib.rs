@@ -55,6 +55,7 @@ pub mod object;
 pub mod plan;
 pub mod report;
 pub mod run;
+mod run_sequence;
 pub mod scene;
 pub mod shadow_volumes;
 pub mod shadowing;
