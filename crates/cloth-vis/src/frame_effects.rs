@@ -64,8 +64,25 @@ impl FrameEffects {
         objects: &mut [WorldObject],
         camera: &Camera,
     ) -> Result<Vec<(Stage, f64, serde_json::Value)>, Error> {
+        self.prepare_where(scene, gpu, objects, camera, true, true)
+    }
+
+    /// [`FrameEffects::prepare`] for the effects switched on (a viewer's toggles): shadow
+    /// volumes when `volumes`, translucency when `translucency`.
+    ///
+    /// # Errors
+    /// Each stage's errors.
+    pub fn prepare_where(
+        &mut self,
+        scene: &Scene,
+        gpu: &GpuContext,
+        objects: &mut [WorldObject],
+        camera: &Camera,
+        volumes: bool,
+        translucency: bool,
+    ) -> Result<Vec<(Stage, f64, serde_json::Value)>, Error> {
         let mut done = Vec::new();
-        if let Some(stage) = self.volumes.as_mut() {
+        if let Some(stage) = self.volumes.as_mut().filter(|_| volumes) {
             let t = std::time::Instant::now();
             let params = stage.prepare(scene, gpu, objects)?;
             done.push((
@@ -74,7 +91,7 @@ impl FrameEffects {
                 params,
             ));
         }
-        if let Some(stage) = self.translucency.as_mut() {
+        if let Some(stage) = self.translucency.as_mut().filter(|_| translucency) {
             let t = std::time::Instant::now();
             let params = stage.prepare(scene, gpu, objects, camera.eye)?;
             done.push((Stage::Translucency, t.elapsed().as_secs_f64() * 1e3, params));
@@ -84,11 +101,16 @@ impl FrameEffects {
 
     /// The passes to hand to the frame.
     pub fn passes(&self) -> Vec<&dyn FramePass> {
+        self.passes_where(true, true)
+    }
+
+    /// The passes of the effects switched on (see [`FrameEffects::prepare_where`]).
+    pub fn passes_where(&self, volumes: bool, translucency: bool) -> Vec<&dyn FramePass> {
         let mut passes: Vec<&dyn FramePass> = Vec::new();
-        if let Some(v) = &self.volumes {
+        if let Some(v) = self.volumes.as_ref().filter(|_| volumes) {
             passes.push(v.pass());
         }
-        if let Some(t) = &self.translucency {
+        if let Some(t) = self.translucency.as_ref().filter(|_| translucency) {
             passes.push(t.pass());
         }
         passes

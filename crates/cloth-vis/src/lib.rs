@@ -51,6 +51,7 @@ mod frame_effects;
 mod image_checks;
 pub mod inputs;
 pub mod lighting;
+pub mod live;
 pub mod object;
 pub mod plan;
 pub mod report;

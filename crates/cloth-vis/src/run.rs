@@ -358,7 +358,7 @@ pub(crate) struct Look {
 }
 
 /// The background a scene asks for; `environment` without an environment is black.
-fn background(scene: &Scene, has_environment: bool) -> Background {
+pub(crate) fn background(scene: &Scene, has_environment: bool) -> Background {
     match scene.output.background {
         BackgroundDesc::Named(BackgroundKeyword::Environment) if has_environment => {
             Background::Environment
@@ -375,7 +375,7 @@ fn background(scene: &Scene, has_environment: bool) -> Background {
 /// use (a stray unreferenced vertex does not shrink the picture), over every frame of `range`
 /// for a sequence, so the camera holds still.
 /// Returns the camera and the sphere (centre, radius) it frames.
-fn frame_camera(
+pub(crate) fn frame_camera(
     scene: &Scene,
     objects: &[WorldObject],
     range: Option<FrameRange>,
@@ -402,7 +402,7 @@ fn frame_camera(
 
 /// A ground grid under the objects: at their lowest point (over the range), centred under
 /// their bounding sphere, `size` radii wide.
-fn ground_object(
+pub(crate) fn ground_object(
     desc: &crate::scene::GroundDesc,
     objects: &[WorldObject],
     range: Option<FrameRange>,
@@ -490,7 +490,7 @@ fn light_frame(
 
 /// A renderer for `scene`: its frame format, the environment backdrop when the background
 /// shows it, and the background itself.
-fn renderer_for(
+pub(crate) fn renderer_for(
     scene: &Scene,
     gpu: &GpuContext,
     environment: Option<&lightsphere::Environment>,

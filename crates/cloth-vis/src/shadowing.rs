@@ -115,24 +115,7 @@ impl VisibilityStage {
         objects: &[WorldObject],
         sphere: &lightsphere::Lightsphere,
     ) -> Result<(Visibility, serde_json::Value), Error> {
-        let mut occ = occlusion_gpu::Scene::new();
-        let mut indices = Vec::with_capacity(objects.len());
-        for object in objects {
-            let front = occ.push(SceneObject::new(
-                object.positions.clone(),
-                object.normals.clone(),
-                object.triangles.clone(),
-            ))?;
-            let back = if object.two_sided {
-                let flipped: Vec<Vec3> = object.normals.iter().map(|n| -*n).collect();
-                let copy =
-                    SceneObject::new(object.positions.clone(), flipped, object.triangles.clone());
-                Some(occ.push(copy)?)
-            } else {
-                None
-            };
-            indices.push((front, back));
-        }
+        let (occ, indices) = occlusion_scene(objects)?;
         let matrix = self.engine.compute(&occ, sphere)?;
         let rows = indices
             .iter()
@@ -153,6 +136,52 @@ impl VisibilityStage {
         });
         Ok((Visibility { matrix, rows }, report))
     }
+
+    /// Refine `visibility` (computed by [`VisibilityStage::compute`] for `objects` as they are
+    /// posed now, at a [`lightsphere::Lightsphere::new`] level) to the finer nested level
+    /// `sphere`, tracing only the new directions (paper 000 §4.2's idle-time refinement).
+    ///
+    /// # Errors
+    /// [`Error::Visibility`] when `sphere` does not extend the matrix's directions or the
+    /// objects changed their vertex counts.
+    pub fn refine(
+        &mut self,
+        objects: &[WorldObject],
+        visibility: &mut Visibility,
+        sphere: &lightsphere::Lightsphere,
+    ) -> Result<(), Error> {
+        let (occ, _) = occlusion_scene(objects)?;
+        self.engine.refine(&occ, &mut visibility.matrix, sphere)?;
+        Ok(())
+    }
+}
+
+/// The receivers and occluders of `objects`: each object's rows, and a second set with
+/// flipped normals for a two-sided object. Returns the scene and each object's (front, back)
+/// indices in it.
+#[allow(clippy::type_complexity)]
+fn occlusion_scene(
+    objects: &[WorldObject],
+) -> Result<(occlusion_gpu::Scene, Vec<(usize, Option<usize>)>), Error> {
+    let mut occ = occlusion_gpu::Scene::new();
+    let mut indices = Vec::with_capacity(objects.len());
+    for object in objects {
+        let front = occ.push(SceneObject::new(
+            object.positions.clone(),
+            object.normals.clone(),
+            object.triangles.clone(),
+        ))?;
+        let back = if object.two_sided {
+            let flipped: Vec<Vec3> = object.normals.iter().map(|n| -*n).collect();
+            let copy =
+                SceneObject::new(object.positions.clone(), flipped, object.triangles.clone());
+            Some(occ.push(copy)?)
+        } else {
+            None
+        };
+        indices.push((front, back));
+    }
+    Ok((occ, indices))
 }
 
 /// Compute M for all objects once ([`VisibilityStage`] built and used for one frame).

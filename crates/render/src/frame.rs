@@ -212,6 +212,23 @@ impl Renderer {
         )?)
     }
 
+    /// Render one frame as [`Renderer::render`] does and leave it on the GPU, read back
+    /// nothing: [`Renderer::hdr_view`] then holds its resolved HDR colour, for a viewer's own
+    /// [`ToneMapPass`] into a window surface.
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn draw_frame(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        camera: &Camera,
+        background: Background,
+        passes: &[&dyn FramePass],
+    ) -> Result<(), RenderError> {
+        self.draw(device, queue, camera, background, passes)
+    }
+
     /// The resolved HDR colour of the last frame drawn (single-sample `Rgba32Float`, bindable
     /// as a texture): what a viewer hands to its own [`ToneMapPass`] for a surface format.
     pub fn hdr_view(&self) -> Option<&wgpu::TextureView> {

@@ -1,0 +1,234 @@
+//! Scripted viewer input (`cloth-vis view --events FILE`): one event per line, replayed one per
+//! presented frame — what the viewer's tests drive it with, and what a pipeline uses to turn a
+//! scene and take pictures without a person at the mouse.
+//!
+//! ```text
+//! # comments and blank lines are skipped
+//! orbit 90 0          # yaw and pitch in degrees
+//! pan 0.1 0           # fractions of the view's height
+//! zoom 0.8            # distance × 0.8
+//! home                # back to the scene's camera
+//! toggle self-shadowing
+//! off shadow-volumes
+//! on shadow-volumes
+//! level 2             # lightsphere level
+//! rotation 45         # environment turn in degrees
+//! exposure -1         # EV; `exposure auto` returns to the scene's
+//! frame 30            # animation frame
+//! play
+//! pause
+//! ```
+
+use std::path::Path;
+
+use crate::Error;
+use crate::effects::Effect;
+
+/// The most events a file may hold (a replay presents one frame per event).
+pub const MAX_EVENTS: usize = 100_000;
+
+/// One scripted input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewEvent {
+    /// Turn the camera: yaw and pitch in degrees ([`super::Orbit::orbit`]).
+    Orbit(f32, f32),
+    /// Pan by fractions of the view's height ([`super::Orbit::pan`]).
+    Pan(f32, f32),
+    /// Multiply the eye's distance to the target (> 0).
+    Zoom(f32),
+    /// Back to the scene's camera.
+    Home,
+    /// Flip an effect.
+    Toggle(Effect),
+    /// Switch an effect on (`true`) or off.
+    Set(Effect, bool),
+    /// The lightsphere level.
+    Level(u32),
+    /// The environment's turn in degrees.
+    Rotation(f32),
+    /// Fixed exposure in EV; `None`: the scene's.
+    Exposure(Option<f32>),
+    /// Pose the animation at this frame.
+    Frame(usize),
+    /// Play the animation (one animation frame per presented frame).
+    Play,
+    /// Pause it.
+    Pause,
+}
+
+/// Read and parse an events file (a regular file, at most [`MAX_EVENTS`] events).
+///
+/// # Errors
+/// [`Error::Io`] when the file cannot be read; [`Error::Request`] naming the file, the line
+/// and the value for a line that does not parse.
+pub fn read_events(path: &Path) -> Result<Vec<ViewEvent>, Error> {
+    let text = input_guard::read_regular_to_string(path).map_err(|e| Error::Io {
+        path: path.to_owned(),
+        reason: e.to_string(),
+    })?;
+    parse_events(&text).map_err(|message| Error::Request {
+        path: path.to_owned(),
+        message,
+    })
+}
+
+/// Parse events, one per line (see the module docs).
+///
+/// # Errors
+/// A message naming the line, its text and what was expected.
+pub fn parse_events(text: &str) -> Result<Vec<ViewEvent>, String> {
+    let mut events = Vec::new();
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        if events.len() == MAX_EVENTS {
+            return Err(format!("more than {MAX_EVENTS} events"));
+        }
+        let event = parse_line(line).map_err(|m| format!("line {}: `{line}`: {m}", i + 1))?;
+        events.push(event);
+    }
+    Ok(events)
+}
+
+fn parse_line(line: &str) -> Result<ViewEvent, String> {
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let args = &words[1..];
+    let count = |n: usize, what: &str| {
+        if args.len() == n {
+            Ok(())
+        } else {
+            Err(format!("takes {what}"))
+        }
+    };
+    let number = |s: &str| -> Result<f32, String> {
+        s.parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("{s:?} is not a finite number"))
+    };
+    let effect = |s: &str| -> Result<Effect, String> {
+        s.parse::<Effect>().map_err(|_| {
+            format!(
+                "unknown effect {s:?} (known: {})",
+                crate::effects::known_effect_names()
+            )
+        })
+    };
+    match words[0] {
+        "orbit" => {
+            count(2, "two numbers: yaw and pitch in degrees")?;
+            Ok(ViewEvent::Orbit(number(args[0])?, number(args[1])?))
+        }
+        "pan" => {
+            count(2, "two numbers: fractions of the view's height")?;
+            Ok(ViewEvent::Pan(number(args[0])?, number(args[1])?))
+        }
+        "zoom" => {
+            count(1, "one factor > 0")?;
+            let f = number(args[0])?;
+            if f <= 0.0 {
+                return Err(format!("{f} is not > 0"));
+            }
+            Ok(ViewEvent::Zoom(f))
+        }
+        "home" => count(0, "nothing").map(|()| ViewEvent::Home),
+        "toggle" => {
+            count(1, "an effect name")?;
+            Ok(ViewEvent::Toggle(effect(args[0])?))
+        }
+        "on" | "off" => {
+            count(1, "an effect name")?;
+            Ok(ViewEvent::Set(effect(args[0])?, words[0] == "on"))
+        }
+        "level" => {
+            count(1, "a lightsphere level")?;
+            let level = args[0]
+                .parse::<u32>()
+                .ok()
+                .filter(|&l| l <= lightsphere::MAX_LEVEL)
+                .ok_or_else(|| {
+                    format!(
+                        "{:?} is not a level 0..={}",
+                        args[0],
+                        lightsphere::MAX_LEVEL
+                    )
+                })?;
+            Ok(ViewEvent::Level(level))
+        }
+        "rotation" => {
+            count(1, "degrees")?;
+            Ok(ViewEvent::Rotation(number(args[0])?))
+        }
+        "exposure" => {
+            count(1, "EV, or auto")?;
+            if args[0] == "auto" {
+                Ok(ViewEvent::Exposure(None))
+            } else {
+                Ok(ViewEvent::Exposure(Some(number(args[0])?)))
+            }
+        }
+        "frame" => {
+            count(1, "a frame index")?;
+            let f = args[0]
+                .parse::<usize>()
+                .map_err(|_| format!("{:?} is not a frame index", args[0]))?;
+            Ok(ViewEvent::Frame(f))
+        }
+        "play" => count(0, "nothing").map(|()| ViewEvent::Play),
+        "pause" => count(0, "nothing").map(|()| ViewEvent::Pause),
+        other => Err(format!(
+            "unknown event {other:?} (orbit, pan, zoom, home, toggle, on, off, level, rotation, \
+             exposure, frame, play, pause)"
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_event_parses_and_comments_are_skipped() {
+        let text = "# a replay\norbit 90 -10\npan 0.1 0\nzoom 0.5\nhome\n\ntoggle self-shadowing\n\
+                    off shadow-volumes  # trailing\non btf\nlevel 2\nrotation 45\nexposure -1\n\
+                    exposure auto\nframe 7\nplay\npause\n";
+        let events = parse_events(text).unwrap();
+        assert_eq!(
+            events,
+            vec![
+                ViewEvent::Orbit(90.0, -10.0),
+                ViewEvent::Pan(0.1, 0.0),
+                ViewEvent::Zoom(0.5),
+                ViewEvent::Home,
+                ViewEvent::Toggle(Effect::SelfShadowing),
+                ViewEvent::Set(Effect::ShadowVolumes, false),
+                ViewEvent::Set(Effect::Btf, true),
+                ViewEvent::Level(2),
+                ViewEvent::Rotation(45.0),
+                ViewEvent::Exposure(Some(-1.0)),
+                ViewEvent::Exposure(None),
+                ViewEvent::Frame(7),
+                ViewEvent::Play,
+                ViewEvent::Pause,
+            ]
+        );
+    }
+
+    #[test]
+    fn bad_lines_name_the_line_and_the_value() {
+        for (text, needle) in [
+            ("orbit 10", "line 1: `orbit 10`: takes two numbers"),
+            ("\nzoom -2", "line 2: `zoom -2`: -2 is not > 0"),
+            ("orbit NaN 0", "\"NaN\" is not a finite number"),
+            ("toggle sparkle", "unknown effect \"sparkle\""),
+            ("level 99", "\"99\" is not a level 0..=8"),
+            ("jump", "unknown event \"jump\""),
+            ("frame -1", "\"-1\" is not a frame index"),
+        ] {
+            let e = parse_events(text).unwrap_err();
+            assert!(e.contains(needle), "{text:?}: {e}");
+        }
+    }
+}
