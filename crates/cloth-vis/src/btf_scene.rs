@@ -154,10 +154,10 @@ impl BtfScene {
         let mut face_materials = BTreeMap::new();
         if !desc.parts.is_empty() {
             for (i, o) in scene.objects.iter().enumerate() {
-                if let crate::scene::GeometrySource::File(path) = scene.geometry_source(i)? {
-                    if let Some(m) = meshio::load_face_materials(&path)? {
-                        face_materials.insert(o.name.clone(), m);
-                    }
+                if let crate::scene::GeometrySource::File(path) = scene.geometry_source(i)?
+                    && let Some(m) = meshio::load_face_materials(&path)?
+                {
+                    face_materials.insert(o.name.clone(), m);
                 }
             }
         }

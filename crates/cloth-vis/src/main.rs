@@ -51,6 +51,11 @@ enum Command {
     Translucency(commands::translucency::TranslucencyArgs),
     /// Load a mesh or an animation and print what the loader found (counts, quirks, time).
     Inspect(commands::inspect::InspectArgs),
+    /// Open a scene, a mesh, an animation or `demo` in a window: orbit, effect toggles, level,
+    /// environment turn, exposure, animation with per-frame self-shadowing; `--frames N
+    /// --screenshot FILE [--events FILE]` for scripts.
+    #[cfg(feature = "viewer")]
+    View(commands::view::ViewArgs),
 }
 
 fn main() -> ExitCode {
@@ -72,6 +77,8 @@ fn main() -> ExitCode {
         Command::Sh(args) => args.run(),
         Command::Translucency(args) => args.run(),
         Command::Inspect(args) => args.run(),
+        #[cfg(feature = "viewer")]
+        Command::View(args) => args.run(),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

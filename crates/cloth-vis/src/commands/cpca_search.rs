@@ -232,13 +232,14 @@ pub(super) fn check_flags(
         anyhow::bail!("{flag} 0: a search limit must be at least 1");
     }
     let targeted = targets[..2].iter().any(|(_, t)| t.is_some());
-    if let Some((flag, _)) = fixed.iter().find(|(_, given)| *given) {
-        if targeted && search == SearchArg::Full {
-            anyhow::bail!(
-                "{flag} is searched with --target-da/--target-bpvf; drop it, or add \
+    if let Some((flag, _)) = fixed.iter().find(|(_, given)| *given)
+        && targeted
+        && search == SearchArg::Full
+    {
+        anyhow::bail!(
+            "{flag} is searched with --target-da/--target-bpvf; drop it, or add \
                  `--search k` to keep it fixed while k alone is searched (thesis §3.3.2)"
-            );
-        }
+        );
     }
     Ok(())
 }

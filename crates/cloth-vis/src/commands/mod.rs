@@ -24,6 +24,10 @@ pub mod shadows;
 pub mod translucency;
 pub mod up_axis;
 mod vat_out;
+#[cfg(feature = "viewer")]
+pub mod view;
+#[cfg(feature = "viewer")]
+mod view_window;
 pub mod visibility;
 
 #[cfg(test)]

@@ -133,25 +133,23 @@ impl Scene {
     /// Checks the `[btf]` table (only when the `btf` effect is requested).
     pub(super) fn validate_btf(&self) -> Result<(), Error> {
         let b = &self.btf;
-        if let BtfSource::File(path) = self.btf_source()? {
-            if !path.exists() {
-                return Err(
-                    self.invalid("btf.source", format!("{} does not exist", path.display()))
-                );
-            }
+        if let BtfSource::File(path) = self.btf_source()?
+            && !path.exists()
+        {
+            return Err(self.invalid("btf.source", format!("{} does not exist", path.display())));
         }
         for (name, source) in &b.parts {
             let key = format!("btf.parts.{name}");
-            if let BtfSource::File(path) = self.material_source(&key, source)? {
-                if !path.is_file() {
-                    return Err(self.invalid(
-                        &key,
-                        format!(
-                            "{} is not a file; give a .btfpca or \"synth:woven\"",
-                            path.display()
-                        ),
-                    ));
-                }
+            if let BtfSource::File(path) = self.material_source(&key, source)?
+                && !path.is_file()
+            {
+                return Err(self.invalid(
+                    &key,
+                    format!(
+                        "{} is not a file; give a .btfpca or \"synth:woven\"",
+                        path.display()
+                    ),
+                ));
             }
         }
         if let Some(name) = b

@@ -492,20 +492,20 @@ impl Scene {
                     "values must be finite".to_owned(),
                 ));
             }
-            if let GeometrySource::File(path) = self.geometry_source(i)? {
-                if !path.exists() {
-                    return Err(
-                        self.invalid(&key("source"), format!("{} does not exist", path.display()))
-                    );
-                }
+            if let GeometrySource::File(path) = self.geometry_source(i)?
+                && !path.exists()
+            {
+                return Err(
+                    self.invalid(&key("source"), format!("{} does not exist", path.display()))
+                );
             }
-            if let Some(path) = self.topology_path(i) {
-                if !path.exists() {
-                    return Err(self.invalid(
-                        &key("topology"),
-                        format!("{} does not exist", path.display()),
-                    ));
-                }
+            if let Some(path) = self.topology_path(i)
+                && !path.exists()
+            {
+                return Err(self.invalid(
+                    &key("topology"),
+                    format!("{} does not exist", path.display()),
+                ));
             }
         }
         if effects.contains(&Effect::Btf) {
@@ -557,21 +557,21 @@ impl Scene {
                 return Err(self.invalid("visibility.max_distance", format!("{d} {why}")));
             }
         }
-        if let Some(EnvironmentSource::File(path)) = self.environment_source()? {
-            if !path.exists() {
-                return Err(self.invalid(
-                    "environment.source",
-                    format!("{} does not exist", path.display()),
-                ));
-            }
+        if let Some(EnvironmentSource::File(path)) = self.environment_source()?
+            && !path.exists()
+        {
+            return Err(self.invalid(
+                "environment.source",
+                format!("{} does not exist", path.display()),
+            ));
         }
-        if let Some(w) = self.synth.sky_width {
-            if !(2..=MAX_SKY_WIDTH).contains(&w) {
-                return Err(self.invalid(
-                    "synth.sky_width",
-                    format!("{w} is outside 2..={MAX_SKY_WIDTH} (cloth_vis::scene::MAX_SKY_WIDTH)"),
-                ));
-            }
+        if let Some(w) = self.synth.sky_width
+            && !(2..=MAX_SKY_WIDTH).contains(&w)
+        {
+            return Err(self.invalid(
+                "synth.sky_width",
+                format!("{w} is outside 2..={MAX_SKY_WIDTH} (cloth_vis::scene::MAX_SKY_WIDTH)"),
+            ));
         }
         // The sky the scene's `[synth]` keys set, checked by the generator itself but refused
         // here, before any work, by the scene's key rather than the library's field.
@@ -637,21 +637,21 @@ impl Scene {
                 format!("{} is outside (0, 179)", cam.fov_deg),
             ));
         }
-        if let ExposureDesc::Fixed(x) = self.output.exposure {
-            if !(x.is_finite() && x.abs() <= 64.0) {
-                return Err(self.invalid(
-                    "output.exposure",
-                    format!("{x} EV must be finite and within ±64, or \"auto\""),
-                ));
-            }
+        if let ExposureDesc::Fixed(x) = self.output.exposure
+            && !(x.is_finite() && x.abs() <= 64.0)
+        {
+            return Err(self.invalid(
+                "output.exposure",
+                format!("{x} EV must be finite and within ±64, or \"auto\""),
+            ));
         }
-        if let BackgroundDesc::Color(c) = self.output.background {
-            if !c.iter().all(|v| v.is_finite() && *v >= 0.0) {
-                return Err(self.invalid(
-                    "output.background",
-                    format!("{c:?}: a colour needs finite linear values ≥ 0"),
-                ));
-            }
+        if let BackgroundDesc::Color(c) = self.output.background
+            && !c.iter().all(|v| v.is_finite() && *v >= 0.0)
+        {
+            return Err(self.invalid(
+                "output.background",
+                format!("{c:?}: a colour needs finite linear values ≥ 0"),
+            ));
         }
         self.frame_range()?;
         if let Some(g) = &self.ground {
@@ -695,18 +695,18 @@ impl Scene {
                 }
             }
         }
-        if let Some(grid) = self.synth.cloth_grid {
-            if !(2..=1024).contains(&grid) {
-                return Err(self.invalid("synth.cloth_grid", format!("{grid} is outside 2..=1024")));
-            }
+        if let Some(grid) = self.synth.cloth_grid
+            && !(2..=1024).contains(&grid)
+        {
+            return Err(self.invalid("synth.cloth_grid", format!("{grid} is outside 2..=1024")));
         }
-        if let Some(frames) = self.synth.cloth_frames {
-            if !(1..=100_000).contains(&frames) {
-                return Err(self.invalid(
-                    "synth.cloth_frames",
-                    format!("{frames} is outside 1..=100000"),
-                ));
-            }
+        if let Some(frames) = self.synth.cloth_frames
+            && !(1..=100_000).contains(&frames)
+        {
+            return Err(self.invalid(
+                "synth.cloth_frames",
+                format!("{frames} is outside 1..=100000"),
+            ));
         }
         Ok(effects)
     }

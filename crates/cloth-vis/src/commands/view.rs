@@ -1,0 +1,260 @@
+//! `cloth-vis view SCENE.toml | MESH | ANIMATION | demo`: the scene in a window — orbit, effect
+//! toggles, level, environment turn, exposure, animation playback with per-frame
+//! self-shadowing and the adaptive level — or, with `--frames N`, a scripted run that presents
+//! N frames, writes the last one and exits (tests, pipelines).
+
+use std::path::{Path, PathBuf};
+
+use cloth_vis::Scene;
+use cloth_vis::live::ViewEvent;
+
+use super::invalid;
+
+/// Open a scene, mesh or animation in an interactive window.
+#[derive(clap::Args)]
+pub struct ViewArgs {
+    /// A scene (.toml), a mesh (OBJ, PLY, glTF), an animation (glTF clip, OBJ folder, .npy),
+    /// or `demo` for the embedded demo scene.
+    input: PathBuf,
+    /// Window size in pixels (default: the scene's camera, at most 1280×960).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    size: Option<(u32, u32)>,
+    /// Scripted: present this many frames, write `--screenshot` and exit.
+    #[arg(long, value_name = "N")]
+    frames: Option<u64>,
+    /// Write the last presented frame here (.png or .exr; the `render` path: the scene's
+    /// display mapping over the frame without the overlay). Needs `--frames`.
+    #[arg(long, value_name = "FILE", requires = "frames")]
+    screenshot: Option<PathBuf>,
+    /// Replay these input events, one per presented frame (see `cloth_vis::live`'s script).
+    #[arg(long, value_name = "FILE")]
+    events: Option<PathBuf>,
+    /// Write every presented frame into DIR as frame-NNNN.png (DIR new or empty).
+    #[arg(long, value_name = "DIR")]
+    record: Option<PathBuf>,
+    /// Adapt the lightsphere level to this visibility time per animated frame (ms); idle
+    /// time refines back to the scene's level.
+    #[arg(long, value_name = "MS")]
+    adaptive: Option<f64>,
+    /// Light a mesh or animation with this HDR map instead of the procedural sky.
+    #[arg(long, value_name = "FILE")]
+    env: Option<PathBuf>,
+    /// Hide the overlay (controls and timings) at start; `H` shows it.
+    #[arg(long)]
+    no_overlay: bool,
+}
+
+/// The largest default window (a scene camera's size is kept below it, aspect preserved).
+const MAX_DEFAULT: (u32, u32) = (1280, 960);
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?} is not WxH (e.g. 800x600)"))?;
+    let parse = |v: &str| {
+        v.parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=8192).contains(&n))
+            .ok_or_else(|| format!("{v:?} in {s:?} is not a size 1..=8192"))
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+/// What the window runs: the scene and the scripted requests, all checked.
+pub struct ViewRequest {
+    /// The scene.
+    pub scene: Scene,
+    /// Window size.
+    pub size: (u32, u32),
+    /// Scripted frame count.
+    pub frames: Option<u64>,
+    /// Where the last frame goes.
+    pub screenshot: Option<PathBuf>,
+    /// Events replayed, one per frame.
+    pub events: Vec<ViewEvent>,
+    /// Recording folder (created).
+    pub record: Option<PathBuf>,
+    /// Adaptive target (ms).
+    pub adaptive_ms: Option<f64>,
+    /// Overlay shown at start.
+    pub overlay: bool,
+}
+
+impl ViewArgs {
+    /// Check everything, then open the window.
+    pub fn run(self) -> anyhow::Result<()> {
+        let request = self.request()?;
+        super::view_window::run(request)
+    }
+
+    fn request(self) -> Result<ViewRequest, cloth_vis::Error> {
+        // A window needs a display: say so before loading anything.
+        let has = |v: &str| std::env::var_os(v).is_some_and(|s| !s.is_empty());
+        if !has("DISPLAY") && !has("WAYLAND_DISPLAY") {
+            return Err(invalid(
+                &self.input,
+                "view opens a window, and there is no display (DISPLAY and WAYLAND_DISPLAY are \
+                 unset); run it on a desktop, or under a virtual one: xvfb-run -a -s \
+                 \"-screen 0 1920x1080x24\" cloth-vis view …"
+                    .to_owned(),
+            ));
+        }
+        if self.frames == Some(0) {
+            return Err(invalid(
+                &self.input,
+                "--frames 0 presents nothing".to_owned(),
+            ));
+        }
+        if let Some(ms) = self.adaptive
+            && !(ms.is_finite() && ms > 0.0)
+        {
+            return Err(invalid(
+                &self.input,
+                format!("--adaptive {ms}: a target time must be > 0 ms"),
+            ));
+        }
+        if let Some(path) = &self.screenshot {
+            check_image_path(path)?;
+            super::refuse_overwriting_input(path, &[&self.input])?;
+        }
+        let events = match &self.events {
+            Some(path) => cloth_vis::live::read_events(path)?,
+            None => Vec::new(),
+        };
+        if let (Some(n), Some(path)) = (self.frames, &self.events)
+            && (n as usize) <= events.len()
+        {
+            return Err(invalid(
+                path,
+                format!(
+                    "{} events are replayed one per frame before the last: --frames {n} is too \
+                     few (at least {})",
+                    events.len(),
+                    events.len() + 1
+                ),
+            ));
+        }
+        if let Some(dir) = &self.record {
+            let holds_files = std::fs::read_dir(dir).is_ok_and(|mut e| e.next().is_some());
+            if holds_files || (dir.exists() && !dir.is_dir()) {
+                return Err(invalid(
+                    dir,
+                    "--record writes frame-NNNN.png into a new or empty folder; this is not one"
+                        .to_owned(),
+                ));
+            }
+        }
+        let scene = self.scene()?;
+        let size = self.size.unwrap_or_else(|| {
+            let (w, h) = (scene.camera.width.max(1), scene.camera.height.max(1));
+            let s = (MAX_DEFAULT.0 as f64 / w as f64)
+                .min(MAX_DEFAULT.1 as f64 / h as f64)
+                .min(1.0);
+            (
+                ((w as f64 * s).round() as u32).max(1),
+                ((h as f64 * s).round() as u32).max(1),
+            )
+        });
+        Ok(ViewRequest {
+            scene,
+            size,
+            frames: self.frames,
+            screenshot: self.screenshot,
+            events,
+            record: self.record,
+            adaptive_ms: self.adaptive,
+            overlay: !self.no_overlay,
+        })
+    }
+
+    /// The scene to view: a scene file, the demo, or a mesh/animation lit by the sky (or
+    /// `--env`) with self-shadowing.
+    fn scene(&self) -> Result<Scene, cloth_vis::Error> {
+        let input = &self.input;
+        if input.as_os_str() == "demo" && !input.exists() {
+            return cloth_vis::demo_scene();
+        }
+        if input
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+        {
+            if self.env.is_some() {
+                return Err(invalid(
+                    input,
+                    "--env lights a mesh or an animation; a scene names its own [environment]"
+                        .to_owned(),
+                ));
+            }
+            return Scene::load(input);
+        }
+        mesh_scene(input, self.env.as_deref())
+    }
+}
+
+/// A mesh or animation as a scene: one two-sided light-grey object lit by the procedural sky
+/// (or `env`) over lightsphere level 3 with self-shadowing, over the environment.
+fn mesh_scene(path: &Path, env: Option<&Path>) -> Result<Scene, cloth_vis::Error> {
+    let text_of = |p: &Path| -> Result<String, cloth_vis::Error> {
+        let s = p
+            .to_str()
+            .ok_or_else(|| invalid(p, "the path is not valid UTF-8; rename the file".to_owned()))?;
+        Ok(toml::Value::String(s.to_owned()).to_string())
+    };
+    let name = path
+        .file_name()
+        .map_or_else(|| "object".to_owned(), |n| n.to_string_lossy().into_owned());
+    let env_source = match env {
+        Some(p) => text_of(&std::path::absolute(p).unwrap_or_else(|_| p.to_owned()))?,
+        None => "\"synth:sky\"".to_owned(),
+    };
+    let source = text_of(&std::path::absolute(path).unwrap_or_else(|_| path.to_owned()))?;
+    let text = format!(
+        "name = {name}\neffects = [\"lighting\", \"self-shadowing\"]\n\n[[object]]\nname = \
+         {name}\nsource = {source}\nalbedo = [0.8, 0.8, 0.8]\ntwo_sided = true\n\n\
+         [environment]\nsource = {env_source}\n\n[lighting]\nlevel = 3\n\n[output]\n\
+         background = \"environment\"\n",
+        name = toml::Value::String(name.clone()),
+    );
+    Scene::from_toml(&text, Path::new(""), &path.display().to_string())
+}
+
+fn check_image_path(path: &Path) -> Result<(), cloth_vis::Error> {
+    match path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .as_deref()
+    {
+        Some("png" | "exr") => Ok(()),
+        _ => Err(invalid(
+            path,
+            "--screenshot writes .png or .exr; name the file with one of them".to_owned(),
+        )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_and_bad_ones_are_named() {
+        assert_eq!(parse_size("800x600"), Ok((800, 600)));
+        assert!(parse_size("800").unwrap_err().contains("not WxH"));
+        assert!(parse_size("0x600").unwrap_err().contains("\"0\""));
+        assert!(parse_size("9000x10").unwrap_err().contains("1..=8192"));
+    }
+
+    #[test]
+    fn a_mesh_scene_is_lit_and_self_shadowed() {
+        let scene = mesh_scene(Path::new("some dir/bunny \"x\".obj"), None).unwrap();
+        assert_eq!(scene.effects, ["lighting", "self-shadowing"]);
+        assert_eq!(scene.objects.len(), 1);
+        assert!(
+            scene.objects[0]
+                .source
+                .ends_with("some dir/bunny \"x\".obj")
+        );
+        assert!(scene.objects[0].two_sided);
+    }
+}

@@ -1,0 +1,326 @@
+//! `cloth-vis view` in a real window: each test runs the binary under Xvfb (`xvfb-run`, which
+//! `.ci/run` installs) on the software adapter, in scripted mode (`--frames N --screenshot
+//! FILE --events FILE`), and compares its picture with `cloth-vis render`'s still of the same
+//! scene and camera. Without `xvfb-run` or a GPU adapter they skip, and fail under CI.
+#![cfg(feature = "viewer")]
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use common::{SMALL_SYNTH, gpu_available, text};
+
+/// The drape and its ball, explicit camera, level 2 so the CPU visibility stays quick.
+fn scene_text(effects: &str, cloth_frame: i32, eye: [f32; 3]) -> String {
+    scene_exposed(effects, cloth_frame, eye, "\"auto\"")
+}
+
+/// [`scene_text`] with `exposure` (TOML: "auto" or EV).
+fn scene_exposed(effects: &str, cloth_frame: i32, eye: [f32; 3], exposure: &str) -> String {
+    format!(
+        r#"
+effects = [{effects}]
+
+[[object]]
+name = "cloth"
+source = "synth:cloth"
+frame = {cloth_frame}
+albedo = [0.72, 0.18, 0.12]
+two_sided = true
+
+[[object]]
+name = "ball"
+source = "synth:cloth-obstacle"
+
+[environment]
+source = "synth:sky"
+
+[lighting]
+level = 2
+
+[camera]
+width = 160
+height = 120
+eye = [{}, {}, {}]
+target = [0.0, 0.4, 0.0]
+
+[output]
+png = "still.png"
+exposure = {exposure}
+{SMALL_SYNTH}"#,
+        eye[0], eye[1], eye[2]
+    )
+}
+
+const SHADOWED: &str = r#""lighting", "self-shadowing""#;
+const EYE: [f32; 3] = [0.3, 1.6, 2.6];
+
+/// `xvfb-run` on this machine, or the skip policy.
+fn xvfb() -> bool {
+    let found = Command::new("xvfb-run")
+        .arg("--help")
+        .output()
+        .is_ok_and(|o| o.status.success() || !o.stdout.is_empty() || !o.stderr.is_empty());
+    if found {
+        return true;
+    }
+    test_data::skip::<()>("xvfb-run is not installed (apt-get install xvfb)").is_some()
+}
+
+fn view(args: &[&str]) -> Output {
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 800x600x24"])
+        .arg(env!("CARGO_BIN_EXE_cloth-vis"))
+        .arg("view")
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "view {args:?} failed: {}\n{}",
+        String::from_utf8_lossy(&out.stderr),
+        String::from_utf8_lossy(&out.stdout)
+    );
+    out
+}
+
+/// Write `text` as `name` in `dir` and render its still with `cloth-vis render`.
+fn render_still(dir: &Path, name: &str, text: &str) -> (PathBuf, PathBuf) {
+    let scene = dir.join(format!("{name}.toml"));
+    std::fs::write(&scene, text).unwrap();
+    let out_dir = dir.join(format!("{name}-out"));
+    let out = common::cli(&[
+        "render",
+        common::text(&scene),
+        "--out",
+        common::text(&out_dir),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (scene, out_dir.join("still.png"))
+}
+
+fn rgba(path: &Path) -> (u32, u32, Vec<u8>) {
+    let img = image::open(path).unwrap().to_rgba8();
+    (img.width(), img.height(), img.into_raw())
+}
+
+/// Mean absolute difference over all channels, in 8-bit codes.
+fn mean_diff(a: &Path, b: &Path) -> f64 {
+    let (wa, ha, pa) = rgba(a);
+    let (wb, hb, pb) = rgba(b);
+    assert_eq!((wa, ha), (wb, hb), "{} vs {}", a.display(), b.display());
+    let total: u64 = pa
+        .iter()
+        .zip(&pb)
+        .map(|(x, y)| u64::from(x.abs_diff(*y)))
+        .sum();
+    total as f64 / pa.len() as f64
+}
+
+fn ready() -> bool {
+    xvfb() && gpu_available()
+}
+
+#[test]
+fn scripted_screenshot_equals_the_render_still() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, still) = render_still(dir.path(), "shadowed", &scene_text(SHADOWED, -1, EYE));
+    let shot = dir.path().join("shot.png");
+    let out = view(&[
+        text(&scene),
+        "--frames",
+        "3",
+        "--screenshot",
+        text(&shot),
+        "--size",
+        "160x120",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("3 frames presented (160×120)"), "{stdout}");
+    let d = mean_diff(&shot, &still);
+    assert!(d <= 1.0, "mean difference {d} codes > 1/255");
+}
+
+#[test]
+fn self_shadowing_off_equals_the_unshadowed_render() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, shadowed) = render_still(dir.path(), "shadowed", &scene_text(SHADOWED, -1, EYE));
+    let (_, plain) = render_still(dir.path(), "plain", &scene_text(r#""lighting""#, -1, EYE));
+    let events = dir.path().join("events.txt");
+    std::fs::write(&events, "off self-shadowing\n").unwrap();
+    let shot = dir.path().join("off.png");
+    let out = view(&[
+        text(&scene),
+        "--frames",
+        "2",
+        "--events",
+        text(&events),
+        "--screenshot",
+        text(&shot),
+        "--size",
+        "160x120",
+    ]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("self-shadowing=off"));
+    let to_plain = mean_diff(&shot, &plain);
+    assert!(
+        to_plain <= 1.0,
+        "mean difference {to_plain} codes to the unshadowed render"
+    );
+    // The toggle changed the picture: the shadowed still is measurably different.
+    let to_shadowed = mean_diff(&shot, &shadowed);
+    assert!(
+        to_shadowed > 2.0 * to_plain.max(0.5),
+        "{to_shadowed} vs {to_plain}"
+    );
+}
+
+#[test]
+fn replayed_orbit_gives_the_expected_camera() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // A fixed exposure: automatic exposure is measured on the viewer's first frame (after
+    // the first event), the still measures its own.
+    let (scene, _) = render_still(
+        dir.path(),
+        "start",
+        &scene_exposed(SHADOWED, -1, EYE, "-2.0"),
+    );
+    let events = dir.path().join("orbit.txt");
+    std::fs::write(&events, "orbit 60 0\norbit 30 0\n").unwrap();
+    let shot = dir.path().join("orbit.png");
+    let out = view(&[
+        text(&scene),
+        "--frames",
+        "3",
+        "--events",
+        text(&events),
+        "--screenshot",
+        text(&shot),
+        "--size",
+        "160x120",
+    ]);
+    // 90° about +Y through the target [0, 0.4, 0]: (x, z) = (0.3, 2.6) → (2.6, −0.3).
+    let expected = [2.6f32, 1.6, -0.3];
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let eye_text = stdout
+        .split("eye [")
+        .nth(1)
+        .and_then(|s| s.split(']').next())
+        .unwrap_or_else(|| panic!("no eye in {stdout}"));
+    let eye: Vec<f32> = eye_text
+        .split(',')
+        .map(|v| v.trim().parse().unwrap())
+        .collect();
+    for (got, want) in eye.iter().zip(expected) {
+        assert!(
+            (got - want).abs() < 1e-4,
+            "eye {eye:?}, expected {expected:?}"
+        );
+    }
+    let (_, turned) = render_still(
+        dir.path(),
+        "turned",
+        &scene_exposed(SHADOWED, -1, expected, "-2.0"),
+    );
+    let d = mean_diff(&shot, &turned);
+    assert!(
+        d <= 1.0,
+        "mean difference {d} codes to the render from the expected eye"
+    );
+}
+
+#[test]
+fn an_animation_frame_is_lit_through_its_own_visibility() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, last) = render_still(dir.path(), "last", &scene_text(SHADOWED, -1, EYE));
+    let (_, early) = render_still(dir.path(), "early", &scene_text(SHADOWED, 12, EYE));
+    let events = dir.path().join("frame.txt");
+    std::fs::write(&events, "frame 12\n").unwrap();
+    let shot = dir.path().join("frame12.png");
+    view(&[
+        text(&scene),
+        "--frames",
+        "2",
+        "--events",
+        text(&events),
+        "--screenshot",
+        text(&shot),
+        "--size",
+        "160x120",
+    ]);
+    let d = mean_diff(&shot, &early);
+    assert!(
+        d <= 1.0,
+        "mean difference {d} codes to the still of frame 12"
+    );
+    assert!(
+        mean_diff(&shot, &last) > 2.0,
+        "frame 12 looks like the last frame"
+    );
+}
+
+#[test]
+fn no_display_is_refused_before_any_work() {
+    let out = Command::new(env!("CARGO_BIN_EXE_cloth-vis"))
+        .args(["view", "demo"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("there is no display"), "{stderr}");
+    assert!(stderr.contains("xvfb-run"), "{stderr}");
+}
+
+#[test]
+fn bad_scripts_and_flags_are_refused_naming_the_value() {
+    let dir = tempfile::tempdir().unwrap();
+    let events = dir.path().join("bad.txt");
+    std::fs::write(&events, "orbit 10 0\ntoggle sparkle\n").unwrap();
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_cloth-vis"))
+            .arg("view")
+            .args(args)
+            .env("DISPLAY", ":7777")
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{args:?} was accepted");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let e = run(&["demo", "--events", text(&events)]);
+    assert!(
+        e.contains("bad.txt") && e.contains("line 2") && e.contains("sparkle"),
+        "{e}"
+    );
+    std::fs::write(&events, "orbit 10 0\norbit 10 0\n").unwrap();
+    let e = run(&["demo", "--events", text(&events), "--frames", "2"]);
+    assert!(e.contains("--frames 2 is too few (at least 3)"), "{e}");
+    let e = run(&["demo", "--frames", "1", "--screenshot", "x.jpg"]);
+    assert!(e.contains("x.jpg") && e.contains(".png or .exr"), "{e}");
+    let e = run(&["demo", "--adaptive=-3"]);
+    assert!(e.contains("--adaptive -3"), "{e}");
+    let e = run(&["demo", "--record", text(dir.path())]);
+    assert!(
+        e.contains("--record") && e.contains("new or empty folder"),
+        "{e}"
+    );
+    let e = run(&["demo", "--size", "0x10"]);
+    assert!(e.contains("\"0\""), "{e}");
+}
