@@ -85,6 +85,27 @@ fn view(args: &[&str]) -> Output {
     out
 }
 
+/// A scripted 160×120 view of `scene` replaying `events` (one per frame, then one frame more),
+/// its last frame written to `dir/NAME.png`. Returns the screenshot and the stdout line.
+fn scripted(dir: &Path, scene: &Path, name: &str, events: &str) -> (PathBuf, String) {
+    let script = dir.join(format!("{name}.txt"));
+    std::fs::write(&script, events).unwrap();
+    let frames = (events.lines().count() + 1).to_string();
+    let shot = dir.join(format!("{name}.png"));
+    let out = view(&[
+        text(scene),
+        "--frames",
+        &frames,
+        "--events",
+        text(&script),
+        "--screenshot",
+        text(&shot),
+        "--size",
+        "160x120",
+    ]);
+    (shot, String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
 /// Write `text` as `name` in `dir` and render its still with `cloth-vis render`.
 fn render_still(dir: &Path, name: &str, text: &str) -> (PathBuf, PathBuf) {
     let scene = dir.join(format!("{name}.toml"));
@@ -157,21 +178,8 @@ fn self_shadowing_off_equals_the_unshadowed_render() {
     let dir = tempfile::tempdir().unwrap();
     let (scene, shadowed) = render_still(dir.path(), "shadowed", &scene_text(SHADOWED, -1, EYE));
     let (_, plain) = render_still(dir.path(), "plain", &scene_text(r#""lighting""#, -1, EYE));
-    let events = dir.path().join("events.txt");
-    std::fs::write(&events, "off self-shadowing\n").unwrap();
-    let shot = dir.path().join("off.png");
-    let out = view(&[
-        text(&scene),
-        "--frames",
-        "2",
-        "--events",
-        text(&events),
-        "--screenshot",
-        text(&shot),
-        "--size",
-        "160x120",
-    ]);
-    assert!(String::from_utf8_lossy(&out.stdout).contains("self-shadowing=off"));
+    let (shot, stdout) = scripted(dir.path(), &scene, "off", "off self-shadowing\n");
+    assert!(stdout.contains("self-shadowing=off"), "{stdout}");
     let to_plain = mean_diff(&shot, &plain);
     assert!(
         to_plain <= 1.0,
@@ -198,23 +206,9 @@ fn replayed_orbit_gives_the_expected_camera() {
         "start",
         &scene_exposed(SHADOWED, -1, EYE, "-2.0"),
     );
-    let events = dir.path().join("orbit.txt");
-    std::fs::write(&events, "orbit 60 0\norbit 30 0\n").unwrap();
-    let shot = dir.path().join("orbit.png");
-    let out = view(&[
-        text(&scene),
-        "--frames",
-        "3",
-        "--events",
-        text(&events),
-        "--screenshot",
-        text(&shot),
-        "--size",
-        "160x120",
-    ]);
+    let (shot, stdout) = scripted(dir.path(), &scene, "orbit", "orbit 60 0\norbit 30 0\n");
     // 90° about +Y through the target [0, 0.4, 0]: (x, z) = (0.3, 2.6) → (2.6, −0.3).
     let expected = [2.6f32, 1.6, -0.3];
-    let stdout = String::from_utf8_lossy(&out.stdout);
     let eye_text = stdout
         .split("eye [")
         .nth(1)
@@ -250,20 +244,7 @@ fn an_animation_frame_is_lit_through_its_own_visibility() {
     let dir = tempfile::tempdir().unwrap();
     let (scene, last) = render_still(dir.path(), "last", &scene_text(SHADOWED, -1, EYE));
     let (_, early) = render_still(dir.path(), "early", &scene_text(SHADOWED, 12, EYE));
-    let events = dir.path().join("frame.txt");
-    std::fs::write(&events, "frame 12\n").unwrap();
-    let shot = dir.path().join("frame12.png");
-    view(&[
-        text(&scene),
-        "--frames",
-        "2",
-        "--events",
-        text(&events),
-        "--screenshot",
-        text(&shot),
-        "--size",
-        "160x120",
-    ]);
+    let (shot, _) = scripted(dir.path(), &scene, "frame12", "frame 12\n");
     let d = mean_diff(&shot, &early);
     assert!(
         d <= 1.0,
