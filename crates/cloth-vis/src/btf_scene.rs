@@ -67,11 +67,11 @@ fn load_material(scene: &Scene, key: &str, source: &str) -> Result<(BtfPca, Stri
 
 /// A drawn item: (material index — 0 the base material, part k at k + 1 —, index of the
 /// chosen object it belongs to, the object or its part).
-type Item = (usize, usize, WorldObject);
+pub(crate) type Item = (usize, usize, WorldObject);
 
 /// The drawn items: every chosen object whole, or split by face material when `[btf] parts`
 /// names materials it has (`face_materials`: per scene object name, its file's materials).
-fn split_into_parts(
+pub(crate) fn split_into_parts(
     chosen: &[&WorldObject],
     parts: &[String],
     face_materials: &BTreeMap<String, meshio::FaceMaterials>,
@@ -114,15 +114,42 @@ fn split_into_parts(
     Ok(items)
 }
 
+/// The objects `[btf] objects` names (all with UVs but the ground when empty).
+///
+/// # Errors
+/// [`Error::Request`] when there is none.
+pub(crate) fn chosen_objects<'a>(
+    desc: &crate::scene::BtfDesc,
+    objects: &'a [WorldObject],
+) -> Result<Vec<&'a WorldObject>, Error> {
+    let chosen: Vec<&WorldObject> = objects
+        .iter()
+        .filter(|o| {
+            if desc.objects.is_empty() {
+                o.uvs.is_some() && o.name != crate::scene::GROUND_NAME
+            } else {
+                desc.objects.contains(&o.name)
+            }
+        })
+        .collect();
+    if chosen.is_empty() {
+        return Err(Error::Request {
+            path: PathBuf::from("btf.objects"),
+            message: "no object to draw with the BTF".to_owned(),
+        });
+    }
+    Ok(chosen)
+}
+
 /// The `btf` stage's materials, loaded once for a still or a whole sequence: the base BTF and
 /// one per part, their plain companions, the fin material, the objects' face materials.
 pub(crate) struct BtfScene {
-    materials: Vec<BtfPca>,
-    plains: Vec<BtfPca>,
+    pub(crate) materials: Vec<BtfPca>,
+    pub(crate) plains: Vec<BtfPca>,
     source: String,
     sources: BTreeMap<String, String>,
-    part_names: Vec<String>,
-    face_materials: BTreeMap<String, meshio::FaceMaterials>,
+    pub(crate) part_names: Vec<String>,
+    pub(crate) face_materials: BTreeMap<String, meshio::FaceMaterials>,
     fins: Option<btf::render::GpuFinRenderer>,
     material_ms: f64,
 }
@@ -240,22 +267,7 @@ impl BtfScene {
             &self.sources,
             self.material_ms,
         );
-        let chosen: Vec<&WorldObject> = objects
-            .iter()
-            .filter(|o| {
-                if desc.objects.is_empty() {
-                    o.uvs.is_some() && o.name != crate::scene::GROUND_NAME
-                } else {
-                    desc.objects.contains(&o.name)
-                }
-            })
-            .collect();
-        if chosen.is_empty() {
-            return Err(Error::Request {
-                path: PathBuf::from("btf.objects"),
-                message: "no object to draw with the BTF".to_owned(),
-            });
-        }
+        let chosen = chosen_objects(desc, objects)?;
         for o in &chosen {
             tangents_of(o)?;
         }

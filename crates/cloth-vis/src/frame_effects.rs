@@ -99,6 +99,30 @@ impl FrameEffects {
         Ok(done)
     }
 
+    /// The first point light of the effects (shadow volumes first, then translucency).
+    pub fn point_light(&self) -> Option<glam::Vec3> {
+        let volumes = self
+            .volumes
+            .as_ref()
+            .and_then(ShadowVolumeStage::point_light);
+        let translucency = self
+            .translucency
+            .as_ref()
+            .and_then(TranslucencyStage::point_light);
+        volumes.or(translucency).map(|p| p.as_vec3())
+    }
+
+    /// Move the first point light of every effect that has one to `position`.
+    pub fn set_point_light(&mut self, position: glam::Vec3) {
+        let p = position.as_dvec3();
+        if let Some(v) = self.volumes.as_mut() {
+            v.set_point_light(p);
+        }
+        if let Some(t) = self.translucency.as_mut() {
+            t.set_point_light(p);
+        }
+    }
+
     /// The passes to hand to the frame.
     pub fn passes(&self) -> Vec<&dyn FramePass> {
         self.passes_where(true, true)

@@ -193,6 +193,42 @@ struct SharedCloth {
     obstacle: synth::Obstacle,
 }
 
+/// One frame (the object's `frame`) of a compressed animation (`.cpca`, thesis §3.3),
+/// decoded on the CPU: a scene shows it as a still; `cloth-vis view` streams the rest through
+/// the GPU decoder.
+fn load_cpca_frame(path: &Path, scene: &Scene, index: usize) -> Result<Geometry, Error> {
+    let refuse = |message: String| Error::Request {
+        path: path.to_owned(),
+        message,
+    };
+    let bytes = input_guard::read_regular(path).map_err(|e| Error::Io {
+        path: path.to_owned(),
+        reason: e.to_string(),
+    })?;
+    let data = anim_pca::Compressed::from_bytes(&bytes).map_err(|e| refuse(e.to_string()))?;
+    if data.triangles().is_empty() {
+        return Err(refuse(
+            "the file stores no triangles (it was compressed from an .npy clip); compress the \
+             clip from a mesh format to show it"
+                .to_owned(),
+        ));
+    }
+    let frame = frame_index(scene, index, data.frames())?;
+    let decoder = anim_pca::compress::Decoder::new(&data);
+    let mut scratch = decoder.scratch();
+    let mut positions = vec![Vec3::ZERO; data.vertices()];
+    decoder
+        .frame_into(frame, &mut positions, &mut scratch)
+        .map_err(|e| refuse(e.to_string()))?;
+    let detail = json!({
+        "source": path.display().to_string(),
+        "frame": frame,
+        "frames": data.frames(),
+        "compressed": true,
+    });
+    Ok((positions, data.triangles().to_vec(), None, detail, None))
+}
+
 fn load_file(path: &Path, scene: &Scene, index: usize) -> Result<Geometry, Error> {
     let has_ext = |ext: &str| {
         path.extension()
@@ -211,6 +247,9 @@ fn load_file(path: &Path, scene: &Scene, index: usize) -> Result<Geometry, Error
     } else {
         None
     };
+    if has_ext("cpca") {
+        return load_cpca_frame(path, scene, index);
+    }
     if let Some((anim, report)) = animation {
         let frame = frame_index(scene, index, anim.frames.len())?;
         let detail = json!({

@@ -77,14 +77,23 @@ impl WorldObject {
         let Some(anim) = &self.animation else {
             return false;
         };
-        let Some(source) = anim.frames.get(frame) else {
+        if frame >= anim.frames.len() {
             return false;
-        };
+        }
+        let (frames, world) = (Arc::clone(&anim.frames), anim.world_from_object);
+        self.pose_positions(&frames[frame], world);
+        true
+    }
+
+    /// Pose the object at object-space `source` positions placed by `world_from_object`
+    /// (a frame from elsewhere: a jump map's player, a GPU decoder), normals recomputed and
+    /// lighting cleared. `source` must have the object's vertex count.
+    pub fn pose_positions(&mut self, source: &[Vec3], world_from_object: Mat4) {
         self.positions.clear();
         self.positions.extend(
             source
                 .iter()
-                .map(|p| anim.world_from_object.transform_point3(*p)),
+                .map(|p| world_from_object.transform_point3(*p)),
         );
         // In world space from the transformed positions, so any transform (including
         // mirroring scales) keeps normals consistent with the winding.
@@ -95,7 +104,6 @@ impl WorldObject {
         );
         self.front = None;
         self.back = None;
-        true
     }
 
     /// Indices of the vertices some triangle uses, ascending (out-of-range indices, which

@@ -236,6 +236,26 @@ impl ShadowVolumeStage {
     pub fn pass(&self) -> &StencilShadows {
         &self.effect
     }
+
+    /// The position of the first point light, if there is one.
+    pub fn point_light(&self) -> Option<glam::DVec3> {
+        self.lights.iter().find_map(|(l, _)| match l {
+            Light::Point(p) => Some(*p),
+            Light::Directional(_) => None,
+        })
+    }
+
+    /// Move the first point light to `position` (a viewer's light control); the next
+    /// [`ShadowVolumeStage::prepare`] builds its volumes from there.
+    pub fn set_point_light(&mut self, position: glam::DVec3) {
+        if let Some((light, _)) = self
+            .lights
+            .iter_mut()
+            .find(|(l, _)| matches!(l, Light::Point(_)))
+        {
+            *light = Light::Point(position);
+        }
+    }
 }
 
 /// The scene's lights: the sky's sun (direction rotated with the environment, irradiance of

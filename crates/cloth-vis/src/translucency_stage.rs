@@ -276,6 +276,22 @@ impl TranslucencyStage {
     pub fn pass(&self) -> &TranslucencyPass {
         &self.pass
     }
+
+    /// The position of its light when that is a point light.
+    pub fn point_light(&self) -> Option<DVec3> {
+        match self.source {
+            Source::Light(Light::Point(p), _) => Some(p),
+            _ => None,
+        }
+    }
+
+    /// Move its point light to `position` (a viewer's light control); a directional light or
+    /// the environment is left as it is.
+    pub fn set_point_light(&mut self, position: DVec3) {
+        if let Source::Light(Light::Point(p), _) = &mut self.source {
+            *p = position;
+        }
+    }
 }
 
 /// Add a light's Lambertian term ρ/π E max(0, ±n·l) to an object's front (and back) vertex

@@ -27,6 +27,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+mod apply;
+mod btf;
 mod orbit;
 mod script;
 
@@ -66,6 +68,21 @@ pub struct LiveSettings {
     pub exposure_ev: Option<f32>,
     /// The animation frame the animated objects are posed at.
     pub frame: usize,
+    /// With the `btf` effect on: draw its objects under plain texture mapping (the BTF's
+    /// frontal normtexture) instead of the BTF — the right half of Fig. 5.16.
+    pub btf_plain: bool,
+    /// The first point light of the shadow-volume and translucency effects (`None` when the
+    /// scene has none); moving it rebuilds their volumes and light maps, not M.
+    pub point_light: Option<Vec3>,
+    /// The environment shown and lighting: 0 the scene's own, then those added with
+    /// [`LiveScene::add_environment`] (M is kept; I_j, the lighting and the backdrop follow).
+    pub environment: usize,
+    /// A tone curve replacing the scene's (`None`: the scene's).
+    pub tone: Option<render::tone::ToneCurve>,
+    /// The visibility backend of self-shadowing (`auto`, `cpu`, `depth`, `query`).
+    pub backend: crate::scene::VisibilityBackendDesc,
+    /// Depth-map side of the `depth` backend.
+    pub depth_resolution: u32,
 }
 
 impl LiveSettings {
@@ -92,10 +109,17 @@ impl LiveSettings {
     }
 }
 
+/// An environment to choose: its name, the map shown and the map lighting the vertices.
+struct EnvChoice {
+    name: String,
+    shown: Option<lightsphere::Environment>,
+    lighting: Option<lightsphere::Environment>,
+}
+
 /// The inputs the vertex lighting was last computed for.
 #[derive(Clone, Debug, PartialEq)]
 struct LitKey {
-    frame: usize,
+    pose: usize,
     level: u32,
     rotation_bits: u32,
     shadowing: bool,
@@ -124,9 +148,14 @@ pub struct LiveScene {
     light_env: Option<lightsphere::Environment>,
     /// The environment shown by the backdrop.
     environment: Option<lightsphere::Environment>,
+    /// The environments to choose from (0: the scene's), and the one in use.
+    choices: Vec<EnvChoice>,
+    chosen: usize,
     shadowing: Option<VisibilityStage>,
     statics: Option<StaticShadowingStage>,
     effects: FrameEffects,
+    btf: Option<btf::LiveBtf>,
+    btf_draws: Vec<::btf::render::BtfDraw>,
     renderer: Renderer,
     background: Background,
     start_camera: Camera,
@@ -141,6 +170,9 @@ pub struct LiveScene {
     lit: Option<LitKey>,
     backdrop_rotation_bits: u32,
     posed: usize,
+    /// Counts geometry changes (an animation frame, a pose from elsewhere): M, the lighting
+    /// and the BTF's environment weights are kept while it holds.
+    pose_id: usize,
     settings: LiveSettings,
     display: Option<Display>,
     times: Vec<StageTime>,
@@ -212,22 +244,45 @@ impl LiveScene {
         } else {
             None
         };
+        let btf = if plan.contains(Stage::Btf) {
+            Some(btf::LiveBtf::new(&scene, &renderer, gpu)?)
+        } else {
+            None
+        };
         let settings = LiveSettings {
             effects: plan.effects().iter().map(|&e| (e, true)).collect(),
             level: scene.lighting.level,
             rotation_deg: 0.0,
             exposure_ev: None,
             frame: posed,
+            btf_plain: false,
+            point_light: effects.point_light(),
+            environment: 0,
+            tone: None,
+            backend: scene.visibility.backend,
+            depth_resolution: scene.visibility.depth_resolution,
         };
+        let choices = vec![EnvChoice {
+            name: scene
+                .environment
+                .as_ref()
+                .map_or_else(|| "none".to_owned(), |e| e.source.clone()),
+            shown: environment.clone(),
+            lighting: light_env.clone(),
+        }];
         Ok(Self {
             scene,
             plan,
             objects,
             light_env,
             environment,
+            choices,
+            chosen: 0,
             shadowing,
             statics,
             effects,
+            btf,
+            btf_draws: Vec::new(),
             renderer,
             background,
             start_camera,
@@ -239,6 +294,7 @@ impl LiveScene {
             lit: None,
             backdrop_rotation_bits: 0f32.to_bits(),
             posed,
+            pose_id: 0,
             settings,
             display: None,
             times: Vec::new(),
@@ -302,6 +358,22 @@ impl LiveScene {
         self.background
     }
 
+    /// Offer `env` (named `name`) as a further environment choice; returns its index for
+    /// [`LiveSettings::environment`].
+    pub fn add_environment(&mut self, name: String, env: lightsphere::Environment) -> usize {
+        self.choices.push(EnvChoice {
+            name,
+            shown: Some(env.clone()),
+            lighting: Some(env),
+        });
+        self.choices.len() - 1
+    }
+
+    /// The names of the environment choices (index 0: the scene's own).
+    pub fn environment_names(&self) -> Vec<&str> {
+        self.choices.iter().map(|c| c.name.as_str()).collect()
+    }
+
     /// The display mapping: the settings' exposure, else the scene's (automatic exposure as
     /// measured on the first frame captured). `None` before the first capture of a scene
     /// with automatic exposure.
@@ -310,65 +382,10 @@ impl LiveScene {
         if let Some(ev) = self.settings.exposure_ev {
             display.exposure_ev = ev;
         }
+        if let Some(curve) = self.settings.tone {
+            display.curve = curve;
+        }
         Some(display)
-    }
-
-    /// Apply one scripted or interactive input to the settings, the camera `orbit` and the
-    /// play state.
-    ///
-    /// # Errors
-    /// A message naming the effect when the scene does not have it, or the level beyond
-    /// the lights' range.
-    pub fn apply(
-        &mut self,
-        event: ViewEvent,
-        orbit: &mut Orbit,
-        playing: &mut bool,
-    ) -> Result<(), String> {
-        let missing = |e: Effect, effects: &[Effect]| {
-            let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
-            format!(
-                "the scene has no effect {:?} (it has: {})",
-                e.name(),
-                names.join(", ")
-            )
-        };
-        match event {
-            ViewEvent::Orbit(yaw, pitch) => orbit.orbit(yaw, pitch),
-            ViewEvent::Pan(dx, dy) => orbit.pan(dx, dy),
-            ViewEvent::Zoom(f) => orbit.zoom(f),
-            ViewEvent::Home => *orbit = Orbit::from_camera(&self.start_camera, self.bounds()),
-            ViewEvent::Toggle(e) => {
-                if !self.settings.toggle(e) {
-                    return Err(missing(e, self.plan.effects()));
-                }
-            }
-            ViewEvent::Set(e, on) => {
-                if !self.settings.set(e, on) {
-                    return Err(missing(e, self.plan.effects()));
-                }
-            }
-            ViewEvent::Level(level) => self.settings.level = level,
-            ViewEvent::Rotation(deg) => self.settings.rotation_deg = deg,
-            ViewEvent::Exposure(ev) => self.settings.exposure_ev = ev,
-            ViewEvent::Frame(f) => {
-                if self.frame_count == 0 {
-                    return Err("the scene has no animated object".to_owned());
-                }
-                self.settings.frame = f % self.frame_count;
-            }
-            ViewEvent::Play => *playing = self.frame_count > 1,
-            ViewEvent::Pause => *playing = false,
-        }
-        Ok(())
-    }
-
-    /// Advance the animation one frame, looping.
-    pub fn step(&mut self, frames: isize) {
-        if self.frame_count > 0 {
-            let n = self.frame_count as isize;
-            self.settings.frame = (self.settings.frame as isize + frames).rem_euclid(n) as usize;
-        }
     }
 
     /// Draw one frame through `camera` into the renderer's target, reading nothing back.
@@ -378,7 +395,7 @@ impl LiveScene {
     pub fn draw(&mut self, gpu: &GpuContext, camera: &Camera) -> Result<(), Error> {
         self.prepare(gpu, camera)?;
         let t = Instant::now();
-        let passes = passes(&self.effects, &self.settings);
+        let passes = passes(&self.effects, &self.btf_draws, &self.settings);
         self.renderer
             .draw_frame(&gpu.device, &gpu.queue, camera, self.background, &passes)?;
         record(
@@ -397,7 +414,7 @@ impl LiveScene {
     pub fn capture(&mut self, gpu: &GpuContext, camera: &Camera) -> Result<HdrImage, Error> {
         self.prepare(gpu, camera)?;
         let t = Instant::now();
-        let passes = passes(&self.effects, &self.settings);
+        let passes = passes(&self.effects, &self.btf_draws, &self.settings);
         let image =
             self.renderer
                 .render(&gpu.device, &gpu.queue, camera, self.background, &passes)?;
@@ -427,11 +444,41 @@ impl LiveScene {
                 }
             }
             self.posed = s.frame;
+            self.pose_id += 1;
             self.time(Stage::Geometry, t);
         }
+        if s.environment != self.chosen && s.environment < self.choices.len() {
+            // Another map: I_j, the lighting, the BTF's weights and the backdrop; M is kept.
+            let choice = &self.choices[s.environment];
+            self.environment = choice.shown.clone();
+            self.light_env = choice.lighting.clone();
+            self.chosen = s.environment;
+            self.lights.clear();
+            self.lit = None;
+            if let Some(b) = self.btf.as_mut() {
+                b.forget_environment();
+            }
+            self.backdrop_rotation_bits = f32::NAN.to_bits();
+        }
         self.turn_backdrop(gpu, s.rotation_deg);
+        if self.shadowing.is_some()
+            && (s.backend, s.depth_resolution)
+                != (
+                    self.scene.visibility.backend,
+                    self.scene.visibility.depth_resolution,
+                )
+        {
+            // A new engine for the new backend: M and the lighting are computed again.
+            let mut scene = self.scene.clone();
+            scene.visibility.backend = s.backend;
+            scene.visibility.depth_resolution = s.depth_resolution;
+            self.shadowing = Some(VisibilityStage::new(&scene, Some(gpu))?);
+            self.scene = scene;
+            self.visibility = None;
+            self.lit = None;
+        }
         let key = LitKey {
-            frame: self.posed,
+            pose: self.pose_id,
             level: s.level,
             rotation_bits: s.rotation_deg.to_bits(),
             shadowing: s.is_on(Effect::SelfShadowing) && self.shadowing.is_some(),
@@ -441,6 +488,11 @@ impl LiveScene {
         if self.lit.as_ref() != Some(&key) {
             self.light(gpu, &key)?;
             self.lit = Some(key);
+        }
+        if let Some(p) = s.point_light
+            && self.effects.point_light() != Some(p)
+        {
+            self.effects.set_point_light(p);
         }
         let (volumes, translucency) = (
             s.is_on(Effect::ShadowVolumes),
@@ -456,7 +508,24 @@ impl LiveScene {
         )? {
             record(&mut self.times, stage.name(), millis);
         }
-        set_gouraud_meshes(gpu, &mut self.renderer, &self.objects, camera, &[])?;
+        self.btf_draws.clear();
+        let mut except = Vec::new();
+        if let Some(live_btf) = self.btf.as_mut().filter(|_| s.is_on(Effect::Btf)) {
+            let t = Instant::now();
+            except = btf::LiveBtf::names(&self.scene, &self.objects)?;
+            self.btf_draws = live_btf.draws(
+                &self.scene,
+                &self.objects,
+                camera,
+                s.btf_plain,
+                self.environment.as_ref(),
+                self.pose_id,
+                s.rotation_deg,
+            )?;
+            record(&mut self.times, Stage::Btf.name(), crate::run::ms_since(t));
+        }
+        let except: Vec<&str> = except.iter().map(String::as_str).collect();
+        set_gouraud_meshes(gpu, &mut self.renderer, &self.objects, camera, &except)?;
         Ok(())
     }
 
@@ -537,14 +606,14 @@ impl LiveScene {
         };
         let t = Instant::now();
         match self.visibility.as_mut() {
-            Some((level, frame, _)) if *level == key.level && *frame == key.frame => return Ok(()),
-            Some((level, frame, vis)) if *level < key.level && *frame == key.frame => {
+            Some((level, frame, _)) if *level == key.level && *frame == key.pose => return Ok(()),
+            Some((level, frame, vis)) if *level < key.level && *frame == key.pose => {
                 stage.refine(&self.objects, vis, sphere)?;
                 *level = key.level;
             }
             _ => {
                 let (vis, _) = stage.compute(&self.objects, sphere)?;
-                self.visibility = Some((key.level, key.frame, vis));
+                self.visibility = Some((key.level, key.pose, vis));
             }
         }
         self.time(Stage::Visibility, t);
@@ -574,12 +643,18 @@ impl LiveScene {
     }
 }
 
-/// The frame passes of the effects switched on.
-fn passes<'a>(effects: &'a FrameEffects, settings: &LiveSettings) -> Vec<&'a dyn FramePass> {
-    effects.passes_where(
+/// The frame passes of the effects switched on: the BTF draws, then the frame effects.
+fn passes<'a>(
+    effects: &'a FrameEffects,
+    btf_draws: &'a [::btf::render::BtfDraw],
+    settings: &LiveSettings,
+) -> Vec<&'a dyn FramePass> {
+    let mut passes: Vec<&dyn FramePass> = btf_draws.iter().map(|d| d as &dyn FramePass).collect();
+    passes.extend(effects.passes_where(
         settings.is_on(Effect::ShadowVolumes),
         settings.is_on(Effect::Translucency),
-    )
+    ));
+    passes
 }
 
 /// Record `stage`'s time for this frame (replacing its last one).

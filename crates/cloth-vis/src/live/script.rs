@@ -13,10 +13,16 @@
 //! on shadow-volumes
 //! level 2             # lightsphere level
 //! rotation 45         # environment turn in degrees
+//! light 0 3 2         # the first point light of shadow volumes / translucency, moved
+//! backend depth 512   # M by GPU depth maps of side 512 (auto, cpu, depth, query)
 //! exposure -1         # EV; `exposure auto` returns to the scene's
+//! tone clamp          # tone curve: aces, clamp (γ 2.2), srgb
+//! environment 1       # 0: the scene's map, then each `--env` map
 //! frame 30            # animation frame
+//! btf-plain on        # the btf effect's objects under plain texture mapping (off: the BTF)
 //! play
 //! pause
+//! next-cell           # a jump map (`view CLIP --jumpmap`): steer to the next cell
 //! ```
 
 use std::path::Path;
@@ -46,12 +52,24 @@ pub enum ViewEvent {
     Level(u32),
     /// The environment's turn in degrees.
     Rotation(f32),
+    /// Choose environment N (0: the scene's own, then each `--env` map).
+    Environment(usize),
+    /// Replace the scene's tone curve.
+    Tone(render::tone::ToneCurve),
+    /// Move the scene's first point light here (world units).
+    PointLight(glam::Vec3),
+    /// The visibility backend, and the depth-map side for `depth`.
+    Backend(crate::scene::VisibilityBackendDesc, Option<u32>),
     /// Fixed exposure in EV; `None`: the scene's.
     Exposure(Option<f32>),
     /// Pose the animation at this frame.
     Frame(usize),
+    /// Draw the `btf` effect's objects under plain texture mapping (`true`) or the BTF.
+    BtfPlain(bool),
     /// Play the animation (one animation frame per presented frame).
     Play,
+    /// Jump map: steer to the next cell (motion control).
+    NextCell,
     /// Pause it.
     Pause,
 }
@@ -157,6 +175,56 @@ fn parse_line(line: &str) -> Result<ViewEvent, String> {
                 })?;
             Ok(ViewEvent::Level(level))
         }
+        "backend" => {
+            use crate::scene::VisibilityBackendDesc as B;
+            if !(1..=2).contains(&args.len()) {
+                return Err(
+                    "takes a backend (auto, cpu, depth, query) and for depth a map side".to_owned(),
+                );
+            }
+            let backend = match args[0] {
+                "auto" => B::Auto,
+                "cpu" => B::Cpu,
+                "depth" => B::Depth,
+                "query" => B::Query,
+                other => return Err(format!("{other:?} is not auto, cpu, depth or query")),
+            };
+            let side = match args.get(1) {
+                None => None,
+                Some(v) => Some(
+                    v.parse::<u32>()
+                        .ok()
+                        .filter(|n| (1..=16384).contains(n))
+                        .ok_or_else(|| format!("{v:?} is not a depth-map side 1..=16384"))?,
+                ),
+            };
+            Ok(ViewEvent::Backend(backend, side))
+        }
+        "light" => {
+            count(3, "three numbers: the point light's position")?;
+            Ok(ViewEvent::PointLight(glam::Vec3::new(
+                number(args[0])?,
+                number(args[1])?,
+                number(args[2])?,
+            )))
+        }
+        "environment" => {
+            count(1, "an environment index (0: the scene's)")?;
+            let i = args[0]
+                .parse::<usize>()
+                .map_err(|_| format!("{:?} is not an environment index", args[0]))?;
+            Ok(ViewEvent::Environment(i))
+        }
+        "tone" => {
+            use render::tone::ToneCurve;
+            count(1, "aces, clamp (γ 2.2) or srgb")?;
+            match args[0] {
+                "aces" => Ok(ViewEvent::Tone(ToneCurve::AcesFitted)),
+                "clamp" => Ok(ViewEvent::Tone(ToneCurve::Clamp { gamma: 2.2 })),
+                "srgb" => Ok(ViewEvent::Tone(ToneCurve::ClampSrgb)),
+                other => Err(format!("{other:?} is not aces, clamp or srgb")),
+            }
+        }
         "rotation" => {
             count(1, "degrees")?;
             Ok(ViewEvent::Rotation(number(args[0])?))
@@ -176,11 +244,20 @@ fn parse_line(line: &str) -> Result<ViewEvent, String> {
                 .map_err(|_| format!("{:?} is not a frame index", args[0]))?;
             Ok(ViewEvent::Frame(f))
         }
+        "btf-plain" => {
+            count(1, "on or off")?;
+            match args[0] {
+                "on" => Ok(ViewEvent::BtfPlain(true)),
+                "off" => Ok(ViewEvent::BtfPlain(false)),
+                other => Err(format!("{other:?} is not on or off")),
+            }
+        }
         "play" => count(0, "nothing").map(|()| ViewEvent::Play),
+        "next-cell" => count(0, "nothing").map(|()| ViewEvent::NextCell),
         "pause" => count(0, "nothing").map(|()| ViewEvent::Pause),
         other => Err(format!(
-            "unknown event {other:?} (orbit, pan, zoom, home, toggle, on, off, level, rotation, \
-             exposure, frame, play, pause)"
+            "unknown event {other:?} (orbit, pan, zoom, home, toggle, on, off, level, light, backend, rotation, environment, tone, \
+             exposure, frame, btf-plain, play, pause, next-cell)"
         )),
     }
 }
@@ -193,7 +270,8 @@ mod tests {
     fn every_event_parses_and_comments_are_skipped() {
         let text = "# a replay\norbit 90 -10\npan 0.1 0\nzoom 0.5\nhome\n\ntoggle self-shadowing\n\
                     off shadow-volumes  # trailing\non btf\nlevel 2\nrotation 45\nexposure -1\n\
-                    exposure auto\nframe 7\nplay\npause\n";
+                    exposure auto\nframe 7\nbtf-plain on\nplay\npause\nnext-cell\n\
+                    light 0 3 -2.5\nbackend depth 512\nbackend cpu\nenvironment 2\ntone srgb\n";
         let events = parse_events(text).unwrap();
         assert_eq!(
             events,
@@ -210,8 +288,15 @@ mod tests {
                 ViewEvent::Exposure(Some(-1.0)),
                 ViewEvent::Exposure(None),
                 ViewEvent::Frame(7),
+                ViewEvent::BtfPlain(true),
                 ViewEvent::Play,
                 ViewEvent::Pause,
+                ViewEvent::NextCell,
+                ViewEvent::PointLight(glam::Vec3::new(0.0, 3.0, -2.5)),
+                ViewEvent::Backend(crate::scene::VisibilityBackendDesc::Depth, Some(512)),
+                ViewEvent::Backend(crate::scene::VisibilityBackendDesc::Cpu, None),
+                ViewEvent::Environment(2),
+                ViewEvent::Tone(render::tone::ToneCurve::ClampSrgb),
             ]
         );
     }
@@ -226,6 +311,9 @@ mod tests {
             ("level 99", "\"99\" is not a level 0..=8"),
             ("jump", "unknown event \"jump\""),
             ("frame -1", "\"-1\" is not a frame index"),
+            ("light 1 2", "takes three numbers"),
+            ("backend gpu", "\"gpu\" is not auto, cpu, depth or query"),
+            ("backend depth 0", "\"0\" is not a depth-map side"),
         ] {
             let e = parse_events(text).unwrap_err();
             assert!(e.contains(needle), "{text:?}: {e}");

@@ -1,0 +1,148 @@
+//! The `btf` effect drawn live (thesis §5.5, Fig. 5.16): the scene's BTF objects as
+//! [`btf::render::BtfDraw`] passes in the viewer's own frame — the compressed BTF, or with
+//! the "plain" switch the same objects under plain texture mapping — while every other object
+//! stays Gouraud-shaded. The materials are uploaded once; under an environment, W per vertex is
+//! kept until the pose or the turn changes. Fins (§5.7) are not drawn live.
+
+use btf::render::{BtfDraw, GpuBtfRenderer, Light, RenderParams};
+use glam::{Vec2, Vec3};
+use gpu_context::GpuContext;
+use render::{Camera, Renderer};
+
+use crate::Error;
+use crate::btf_scene::{BtfScene, chosen_objects, split_into_parts};
+use crate::btf_stage::{btf_mesh, tangents_of};
+use crate::object::WorldObject;
+use crate::scene::{BtfIllumination, Scene};
+
+/// W per drawn item, for (pose, turn bits).
+type EnvCache = ((usize, u32), Vec<Vec<btf::env::EnvLightWeights>>);
+
+/// The scene's BTF materials on the GPU, and the environment weights of the current pose.
+pub(crate) struct LiveBtf {
+    scene_btf: BtfScene,
+    with: Vec<GpuBtfRenderer>,
+    plain: Vec<GpuBtfRenderer>,
+    env: Option<EnvCache>,
+}
+
+impl LiveBtf {
+    /// Load `[btf]`'s materials and upload them and their plain companions once.
+    pub(crate) fn new(scene: &Scene, renderer: &Renderer, gpu: &GpuContext) -> Result<Self, Error> {
+        let scene_btf = BtfScene::load(scene, renderer, gpu)?;
+        let upload = |materials: &[btf::BtfPca]| {
+            materials
+                .iter()
+                .map(|pca| {
+                    GpuBtfRenderer::for_frame(
+                        &gpu.device,
+                        &gpu.queue,
+                        pca,
+                        &renderer.pass_context(),
+                    )
+                })
+                .collect::<Result<Vec<_>, _>>()
+        };
+        let with = upload(&scene_btf.materials)?;
+        let plain = upload(&scene_btf.plains)?;
+        Ok(Self {
+            scene_btf,
+            with,
+            plain,
+            env: None,
+        })
+    }
+
+    /// Drop the environment weights (another map was chosen).
+    pub(crate) fn forget_environment(&mut self) {
+        self.env = None;
+    }
+
+    /// The names of the objects the BTF draws (the Gouraud pass skips them).
+    pub(crate) fn names(scene: &Scene, objects: &[WorldObject]) -> Result<Vec<String>, Error> {
+        Ok(chosen_objects(&scene.btf, objects)?
+            .iter()
+            .map(|o| o.name.clone())
+            .collect())
+    }
+
+    /// This frame's draws: each BTF object (or garment part) with its material, or its plain
+    /// companion when `plain`, lit by `[btf]`'s light or by `environment` turned by
+    /// `rotation_deg` (W recomputed only when `pose` or the turn changed).
+    #[allow(clippy::too_many_arguments)] // one frame's inputs
+    pub(crate) fn draws(
+        &mut self,
+        scene: &Scene,
+        objects: &[WorldObject],
+        camera: &Camera,
+        plain: bool,
+        environment: Option<&lightsphere::Environment>,
+        pose: usize,
+        rotation_deg: f32,
+    ) -> Result<Vec<BtfDraw>, Error> {
+        let desc = &scene.btf;
+        let chosen = chosen_objects(desc, objects)?;
+        let items = split_into_parts(
+            &chosen,
+            &self.scene_btf.part_names,
+            &self.scene_btf.face_materials,
+        )?;
+        let mut params = RenderParams::default();
+        params.uv_scale = Vec2::splat(desc.uv_scale);
+        let weights = match (desc.illumination, environment) {
+            (BtfIllumination::Light, _) => None,
+            (BtfIllumination::Environment, None) => {
+                return Err(Error::Scene {
+                    origin: scene.origin.clone(),
+                    message: "btf illumination = \"environment\" without an environment".to_owned(),
+                });
+            }
+            (BtfIllumination::Environment, Some(env)) => {
+                let key = (pose, rotation_deg.to_bits());
+                if self.env.as_ref().is_none_or(|(k, _)| *k != key) {
+                    let lighting = crate::btf_env::EnvLighting {
+                        env,
+                        up: Vec3::Y,
+                        rotation_deg,
+                        visibility: match desc.maps {
+                            Some(res) => crate::btf_env::EnvVisibility::Maps {
+                                model: hemicube::Model::Hemicube { res },
+                            },
+                            None => crate::btf_env::EnvVisibility::Matrix { level: desc.level },
+                        },
+                        decompose: None,
+                    };
+                    let ws = items
+                        .iter()
+                        .map(|(m, o, _)| {
+                            crate::btf_env::env_weights(
+                                &self.scene_btf.materials[*m],
+                                chosen[*o],
+                                &lighting,
+                            )
+                            .map(|(w, _)| w)
+                        })
+                        .collect::<Result<Vec<_>, _>>()?;
+                    self.env = Some((key, ws));
+                }
+                self.env.as_ref().map(|(_, ws)| ws)
+            }
+        };
+        let light = Light::Directional {
+            dir_to_light_world: Vec3::from(desc.light_dir),
+            radiance: Vec3::from(desc.radiance),
+        };
+        let renderers = if plain { &self.plain } else { &self.with };
+        let mut draws = Vec::with_capacity(items.len());
+        for (i, (m, _, object)) in items.iter().enumerate() {
+            let (tangents, uvs) = tangents_of(object)?;
+            let mesh = btf_mesh(object, &tangents, uvs);
+            let draw = match weights {
+                None => renderers[*m].prepare(&mesh, &light, camera, &params)?,
+                Some(ws) => renderers[*m].prepare_env(&mesh, &ws[i], camera, &params)?,
+            };
+            draws.push(draw);
+        }
+        Ok(draws)
+    }
+}
