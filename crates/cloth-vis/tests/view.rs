@@ -204,7 +204,7 @@ fn replayed_orbit_gives_the_expected_camera() {
     let (scene, _) = render_still(
         dir.path(),
         "start",
-        &scene_exposed(SHADOWED, -1, EYE, "-2.0"),
+        &scene_exposed(SHADOWED, -1, EYE, "-4.0"),
     );
     let (shot, stdout) = scripted(dir.path(), &scene, "orbit", "orbit 60 0\norbit 30 0\n");
     // 90° about +Y through the target [0, 0.4, 0]: (x, z) = (0.3, 2.6) → (2.6, −0.3).
@@ -227,7 +227,7 @@ fn replayed_orbit_gives_the_expected_camera() {
     let (_, turned) = render_still(
         dir.path(),
         "turned",
-        &scene_exposed(SHADOWED, -1, expected, "-2.0"),
+        &scene_exposed(SHADOWED, -1, expected, "-4.0"),
     );
     let d = mean_diff(&shot, &turned);
     assert!(
@@ -304,4 +304,277 @@ fn bad_scripts_and_flags_are_refused_naming_the_value() {
     );
     let e = run(&["demo", "--size", "0x10"]);
     assert!(e.contains("\"0\""), "{e}");
+}
+
+/// The cloth with the synthetic woven BTF beside plain texturing (the demo's `btf` effect,
+/// small), at a fixed exposure so both halves share it as `render`'s btf.png does.
+fn btf_scene() -> String {
+    let base = scene_exposed(r#""lighting", "btf""#, -1, EYE, "-1.0");
+    format!(
+        "{base}\n[btf]\nsource = \"synth:woven\"\nobjects = [\"cloth\"]\nres = 16\n\
+         components = 4\nlight_dir = [0.2, 0.9, 0.6]\nuv_scale = 4.0\npng = \"btf.png\"\n"
+    )
+}
+
+/// One half of a side-by-side PNG, written as its own PNG.
+fn half(path: &Path, right: bool, out: &Path) {
+    let img = image::open(path).unwrap().to_rgba8();
+    let w = img.width() / 2;
+    let x = if right { w } else { 0 };
+    image::imageops::crop_imm(&img, x, 0, w, img.height())
+        .to_image()
+        .save(out)
+        .unwrap();
+}
+
+#[test]
+fn btf_and_plain_texture_equal_the_halves_of_the_render() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, still) = render_still(dir.path(), "btf", &btf_scene());
+    let pair = still.with_file_name("btf.png");
+    let (left, right) = (dir.path().join("left.png"), dir.path().join("right.png"));
+    half(&pair, false, &left);
+    half(&pair, true, &right);
+    let (with_btf, _) = scripted(dir.path(), &scene, "with", "btf-plain off\n");
+    let (plain, _) = scripted(dir.path(), &scene, "plain", "btf-plain on\n");
+    let (off, _) = scripted(dir.path(), &scene, "off", "off btf\n");
+    for (shot, want, what) in [
+        (&with_btf, &left, "BTF"),
+        (&plain, &right, "plain texture"),
+        (&off, &still, "btf off: the still"),
+    ] {
+        let d = mean_diff(shot, want);
+        assert!(d <= 1.0, "{what}: mean difference {d} codes");
+    }
+    // The switch changes the cloth: BTF and plain texture differ.
+    assert!(mean_diff(&with_btf, &plain) > 1.0);
+}
+
+/// A scene of one clip file (relative to the scene), explicit camera on the chicken.
+fn clip_scene(source: &str, frame: usize) -> String {
+    format!(
+        r#"
+effects = ["lighting", "self-shadowing"]
+
+[[object]]
+name = "clip"
+source = "{source}"
+frame = {frame}
+two_sided = true
+
+[environment]
+source = "synth:sky"
+
+[lighting]
+level = 1
+
+[camera]
+width = 160
+height = 120
+eye = [28.0, 1.85, 11.4]
+target = [26.0, 0.7, 8.8]
+
+[output]
+png = "still.png"
+exposure = -2.5
+background = "black"
+"#
+    )
+}
+
+/// The value after `key` in the summary line, up to the next `,` or `;`.
+fn after<'a>(stdout: &'a str, key: &str) -> Option<&'a str> {
+    let rest = stdout.split(key).nth(1)?;
+    rest.split([',', ';']).next()
+}
+
+#[test]
+fn a_cpca_streams_through_the_gpu_decoder_with_its_own_visibility() {
+    let Some(chicken) = test_data::shared_file("anim/chickenCrossing") else {
+        return;
+    };
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cpca = dir.path().join("chicken.cpca");
+    let out = common::cli(&[
+        "anim",
+        "compress",
+        text(&chicken),
+        "--out",
+        text(&cpca),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (scene, first) = render_still(dir.path(), "first", &clip_scene("chicken.cpca", 0));
+    let (_, later) = render_still(dir.path(), "later", &clip_scene("chicken.cpca", 90));
+    // Frame 90 decoded on the GPU = the CPU decoder's frame 90, lit through its own M.
+    let (shot, stdout) = scripted(dir.path(), &scene, "seek", "frame 90\n");
+    assert!(
+        stdout.contains("cpca frame 90 of 170 (GPU decoder)"),
+        "{stdout}"
+    );
+    let d = mean_diff(&shot, &later);
+    assert!(
+        d <= 1.0,
+        "mean difference {d} codes to the still of frame 90"
+    );
+    assert!(
+        mean_diff(&shot, &first) > 1.0,
+        "frame 90 looks like frame 0"
+    );
+    // Playing advances one decoded frame per presented frame.
+    let (_, stdout) = scripted(dir.path(), &scene, "play", "play\n");
+    assert!(stdout.contains("cpca frame 1 of 170"), "{stdout}");
+}
+
+#[test]
+fn a_jump_map_plays_clip_frames_lit_through_their_own_visibility() {
+    let Some(chicken) = test_data::shared_file("anim/chickenCrossing") else {
+        return;
+    };
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let source = chicken.to_str().unwrap();
+    let (scene, _) = render_still(dir.path(), "jump", &clip_scene(source, 0));
+    let script = dir.path().join("jump.txt");
+    std::fs::write(&script, "play\nnext-cell\n").unwrap();
+    let shot = dir.path().join("jump.png");
+    // Long enough to take jumps; the last frame is compared when it is a clip frame.
+    for frames in ["61", "62", "63"] {
+        let out = view(&[
+            text(&scene),
+            "--jumpmap",
+            "--seed",
+            "7",
+            "--frames",
+            frames,
+            "--events",
+            text(&script),
+            "--screenshot",
+            text(&shot),
+            "--size",
+            "160x120",
+        ]);
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(stdout.contains("jump map: "), "{stdout}");
+        let Some(frame) = after(&stdout, "jump map: clip frame ") else {
+            continue; // a blend frame: try one frame later
+        };
+        let (_, still) = render_still(
+            dir.path(),
+            &format!("clip{frame}"),
+            &clip_scene(source, frame.trim().parse().unwrap()),
+        );
+        let d = mean_diff(&shot, &still);
+        assert!(d <= 1.0, "clip frame {frame}: mean difference {d} codes");
+        return;
+    }
+    panic!("three consecutive blend frames at the end of the run");
+}
+
+#[test]
+fn backend_switch_equals_the_render_through_that_backend() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, _) = render_still(dir.path(), "cpu", &scene_text(SHADOWED, -1, EYE));
+    let depth = scene_text(SHADOWED, -1, EYE)
+        + "\n[visibility]\nbackend = \"depth\"\ndepth_resolution = 128\n";
+    let (_, want) = render_still(dir.path(), "depth", &depth);
+    let (shot, _) = scripted(dir.path(), &scene, "to-depth", "backend depth 128\n");
+    let d = mean_diff(&shot, &want);
+    assert!(
+        d <= 1.0,
+        "mean difference {d} codes to the depth-backend render"
+    );
+}
+
+/// The drape on the ground under a point light casting shadow volumes, light at `light`.
+fn point_light_scene(light: [f32; 3]) -> String {
+    let base = scene_exposed(r#""lighting", "shadow-volumes""#, -1, EYE, "-4.0");
+    format!(
+        "{base}\n[ground]\ncells = 8\n\n[[shadow_volumes.light]]\nposition = [{}, {}, {}]\n\
+         intensity = [60.0, 60.0, 60.0]\n",
+        light[0], light[1], light[2]
+    )
+}
+
+#[test]
+fn a_moved_point_light_equals_the_render_with_the_light_there() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, before) = render_still(dir.path(), "before", &point_light_scene([1.5, 2.5, 1.0]));
+    let (_, want) = render_still(dir.path(), "after", &point_light_scene([-1.5, 2.0, -0.5]));
+    let (shot, _) = scripted(dir.path(), &scene, "moved", "light -1.5 2 -0.5\n");
+    let d = mean_diff(&shot, &want);
+    assert!(
+        d <= 1.0,
+        "mean difference {d} codes to the render with the light moved"
+    );
+    assert!(
+        mean_diff(&shot, &before) > 1.0,
+        "moving the light changed nothing"
+    );
+}
+
+#[test]
+fn another_environment_and_tone_curve_equal_the_render_with_them() {
+    let Some(venice) = test_data::shared_file("env/venice_sunset_1k.hdr") else {
+        return;
+    };
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let sky = scene_exposed(SHADOWED, -1, EYE, "-4.0");
+    let (scene, _) = render_still(dir.path(), "sky", &sky);
+    let map = sky.replace(
+        "source = \"synth:sky\"",
+        &format!("source = {:?}", venice.to_str().unwrap()),
+    );
+    let (_, want) = render_still(dir.path(), "venice", &map);
+    let script = dir.path().join("env.txt");
+    std::fs::write(&script, "environment 1\n").unwrap();
+    let shot = dir.path().join("env.png");
+    view(&[
+        text(&scene),
+        "--env",
+        text(&venice),
+        "--frames",
+        "2",
+        "--events",
+        text(&script),
+        "--screenshot",
+        text(&shot),
+        "--size",
+        "160x120",
+    ]);
+    let d = mean_diff(&shot, &want);
+    assert!(
+        d <= 1.0,
+        "mean difference {d} codes to the render under the map"
+    );
+    // The tone curve: clamp + γ 2.2 as the scene's [output] would set it.
+    let (_, clamped) = render_still(
+        dir.path(),
+        "clamped",
+        &sky.replace("exposure = -4.0", "exposure = -4.0\ntone = \"clamp\""),
+    );
+    let (shot, _) = scripted(dir.path(), &scene, "tone", "tone clamp\n");
+    let d = mean_diff(&shot, &clamped);
+    assert!(d <= 1.0, "mean difference {d} codes to the clamped render");
 }

@@ -27,6 +27,10 @@ mod vat_out;
 #[cfg(feature = "viewer")]
 pub mod view;
 #[cfg(feature = "viewer")]
+mod view_hud;
+#[cfg(feature = "viewer")]
+mod view_motion;
+#[cfg(feature = "viewer")]
 mod view_window;
 pub mod visibility;
 

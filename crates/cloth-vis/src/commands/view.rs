@@ -36,12 +36,34 @@ pub struct ViewArgs {
     /// time refines back to the scene's level.
     #[arg(long, value_name = "MS")]
     adaptive: Option<f64>,
-    /// Light a mesh or animation with this HDR map instead of the procedural sky.
+    /// An HDR map to choose in the overlay (repeatable; the `environment N` event): a mesh
+    /// or animation is lit by the first instead of the procedural sky.
     #[arg(long, value_name = "FILE")]
-    env: Option<PathBuf>,
+    env: Vec<PathBuf>,
+    /// Size of `--screenshot` (and the `P` key's) pictures, when not the window's.
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    screenshot_size: Option<(u32, u32)>,
     /// Hide the overlay (controls and timings) at start; `H` shows it.
     #[arg(long)]
     no_overlay: bool,
+    /// Play the animation as a jump map (thesis §3.2): endless, jumping between similar
+    /// frames; `C` (or the event `next-cell`) steers to the next cell.
+    #[arg(long)]
+    jumpmap: bool,
+    /// Another clip of the same mesh as a further jump-map cell (repeatable; with --jumpmap).
+    #[arg(long, value_name = "CLIP", requires = "jumpmap")]
+    cell: Vec<PathBuf>,
+    /// Seed of the jump map's random play.
+    #[arg(long, default_value_t = 1, requires = "jumpmap")]
+    seed: u64,
+}
+
+/// Where the poses come from besides the scene's own clip.
+pub enum MotionSource {
+    /// A jump map over these clips (frames per clip), seeded.
+    JumpMap(Vec<Vec<Vec<glam::Vec3>>>, u64),
+    /// A compressed animation for the GPU decoder.
+    Cpca(Box<anim_pca::Compressed>),
 }
 
 /// The largest default window (a scene camera's size is kept below it, aspect preserved).
@@ -78,6 +100,12 @@ pub struct ViewRequest {
     pub adaptive_ms: Option<f64>,
     /// Overlay shown at start.
     pub overlay: bool,
+    /// Poses from a jump map or a `.cpca`.
+    pub motion: Option<MotionSource>,
+    /// Further environment maps to choose from.
+    pub environments: Vec<PathBuf>,
+    /// Screenshot size when not the window's.
+    pub screenshot_size: Option<(u32, u32)>,
 }
 
 impl ViewArgs {
@@ -145,6 +173,8 @@ impl ViewArgs {
             }
         }
         let scene = self.scene()?;
+        let motion = self.motion(&scene)?;
+        let environments = self.extra_environments();
         let size = self.size.unwrap_or_else(|| {
             let (w, h) = (scene.camera.width.max(1), scene.camera.height.max(1));
             let s = (MAX_DEFAULT.0 as f64 / w as f64)
@@ -164,7 +194,61 @@ impl ViewArgs {
             record: self.record,
             adaptive_ms: self.adaptive,
             overlay: !self.no_overlay,
+            motion,
+            environments,
+            screenshot_size: self.screenshot_size,
         })
+    }
+
+    /// The jump map's clips, or the `.cpca` for the GPU decoder: the input, or a scene's
+    /// first object loaded from a file.
+    fn motion(&self, scene: &Scene) -> Result<Option<MotionSource>, cloth_vis::Error> {
+        let clip = match scene.geometry_source(0) {
+            Ok(cloth_vis::scene::GeometrySource::File(path)) => path,
+            _ if self.jumpmap => {
+                return Err(invalid(
+                    &self.input,
+                    "--jumpmap plays the scene's first object, and it is not a clip file"
+                        .to_owned(),
+                ));
+            }
+            _ => return Ok(None),
+        };
+        let is_cpca = clip
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("cpca"));
+        if is_cpca {
+            if self.jumpmap {
+                return Err(invalid(
+                    &clip,
+                    "--jumpmap analyses a clip of meshes; a .cpca streams as it is".to_owned(),
+                ));
+            }
+            let (data, _) = super::cpca::read_cpca(&clip)?;
+            return Ok(Some(MotionSource::Cpca(Box::new(data))));
+        }
+        if !self.jumpmap {
+            return Ok(None);
+        }
+        let options = meshio::AnimationOptions::default();
+        let mut cells = Vec::new();
+        for path in std::iter::once(&clip).chain(&self.cell) {
+            let (clip, _) = meshio::load_animation(path, &options)?;
+            if let Some(first) = cells.first().and_then(|c: &Vec<Vec<glam::Vec3>>| c.first())
+                && clip.frames.first().map(Vec::len) != Some(first.len())
+            {
+                return Err(invalid(
+                    path,
+                    format!(
+                        "a jump-map cell must have the input's {} vertices; this clip has {}",
+                        first.len(),
+                        clip.frames.first().map_or(0, Vec::len)
+                    ),
+                ));
+            }
+            cells.push(clip.frames);
+        }
+        Ok(Some(MotionSource::JumpMap(cells, self.seed)))
     }
 
     /// The scene to view: a scene file, the demo, or a mesh/animation lit by the sky (or
@@ -174,20 +258,24 @@ impl ViewArgs {
         if input.as_os_str() == "demo" && !input.exists() {
             return cloth_vis::demo_scene();
         }
-        if input
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
-        {
-            if self.env.is_some() {
-                return Err(invalid(
-                    input,
-                    "--env lights a mesh or an animation; a scene names its own [environment]"
-                        .to_owned(),
-                ));
-            }
+        if self.is_scene() {
             return Scene::load(input);
         }
-        mesh_scene(input, self.env.as_deref())
+        mesh_scene(input, self.env.first().map(PathBuf::as_path))
+    }
+
+    fn is_scene(&self) -> bool {
+        self.input.as_os_str() == "demo" && !self.input.exists()
+            || self
+                .input
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+    }
+
+    /// The `--env` maps offered besides the scene's own (a mesh's first lights it already).
+    fn extra_environments(&self) -> Vec<PathBuf> {
+        let skip = usize::from(!self.is_scene());
+        self.env.iter().skip(skip).cloned().collect()
     }
 }
 

@@ -18,7 +18,9 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
 
-use super::view::ViewRequest;
+use super::view::{MotionSource, ViewRequest};
+use super::view_hud::{FrameStats, Hud, UiRequests};
+use super::view_motion::{CpcaMotion, JumpMotion, Motion};
 
 /// Degrees of orbit per pixel dragged.
 const ORBIT_DEG_PER_PIXEL: f32 = 0.4;
@@ -29,11 +31,32 @@ const IDLE_REFINE_AFTER: Duration = Duration::from_millis(300);
 pub fn run(request: ViewRequest) -> anyhow::Result<()> {
     let gpu = GpuContext::new(&GpuOptions::default())
         .map_err(|e| anyhow::anyhow!("cloth-vis view renders on the GPU: {e}"))?;
-    let live = LiveScene::new(request.scene.clone(), &gpu)?;
+    let mut live = LiveScene::new(request.scene.clone(), &gpu)?;
+    for path in &request.environments {
+        let env = lightsphere::Environment::load(path)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        live.add_environment(path.display().to_string(), env);
+    }
+    let motion = match &request.motion {
+        None => None,
+        Some(MotionSource::JumpMap(cells, seed)) => {
+            let step = super::spinner(true, "analysing the jump map".to_owned());
+            let m = JumpMotion::new(cells.clone(), *seed)?;
+            step.finish_and_clear();
+            Some(Motion::JumpMap(Box::new(m)))
+        }
+        Some(MotionSource::Cpca(data)) => Some(Motion::Cpca(CpcaMotion::new(
+            &gpu.device,
+            &gpu.queue,
+            data,
+            0,
+        )?)),
+    };
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow::anyhow!("cloth-vis view could not reach the display ({e}); is DISPLAY right?")
     })?;
     let mut app = App::new(request, gpu, live);
+    app.motion = motion;
     event_loop.run_app(&mut app)?;
     if let Some(e) = app.failure.take() {
         return Err(e);
@@ -70,7 +93,9 @@ struct App {
     cursor: (f64, f64),
     last_input: Instant,
     frame_ms: f64,
+    stats: FrameStats,
     controller: Option<LevelController>,
+    motion: Option<Motion>,
     screenshots: u32,
     status: String,
 }
@@ -99,7 +124,9 @@ impl App {
             cursor: (0.0, 0.0),
             last_input: Instant::now(),
             frame_ms: 0.0,
+            stats: FrameStats::default(),
             controller,
+            motion: None,
             screenshots: 0,
             status: String::new(),
         }
@@ -125,11 +152,16 @@ impl App {
             .map(|(e, on)| format!("{}={}", e.name(), if *on { "on" } else { "off" }))
             .collect();
         Some(format!(
-            "view: {} frames presented ({w}×{h}); level {}; {}; eye [{:.6}, {:.6}, {:.6}] target \
-             [{:.6}, {:.6}, {:.6}]{}",
+            "view: {} frames presented ({w}×{h}); {}; level {}; {}{}; eye [{:.6}, {:.6}, {:.6}] \
+             target [{:.6}, {:.6}, {:.6}]{}",
             self.presented,
+            self.stats,
             self.live.settings().level,
             effects.join(" "),
+            self.motion
+                .as_ref()
+                .map(|m| format!("; {}", m.status()))
+                .unwrap_or_default(),
             e.x,
             e.y,
             e.z,
@@ -234,13 +266,10 @@ impl App {
         let start = Instant::now();
         let index = self.presented as usize;
         if let Some(&event) = self.request.events.get(index) {
-            let mut playing = self.playing;
-            self.live
-                .apply(event, &mut self.orbit, &mut playing)
+            self.apply(event)
                 .map_err(|m| anyhow::anyhow!("event {} ({event:?}): {m}", index + 1))?;
-            self.playing = playing;
         } else if self.playing {
-            self.live.step(1);
+            self.advance(1).map_err(|m| anyhow::anyhow!("{m}"))?;
         }
         let (w, h) = self.size();
         let camera = self.orbit.camera(w, h);
@@ -299,7 +328,9 @@ impl App {
         let raw = shown.egui_state.take_egui_input(&shown.window);
         let mut requests = UiRequests::default();
         let overlay = self.overlay;
+        let motion_status = self.motion.as_ref().map(Motion::status);
         let mut hud = Hud {
+            motion: motion_status.as_deref(),
             live: &mut self.live,
             frame_ms: self.frame_ms,
             playing: &mut self.playing,
@@ -373,7 +404,13 @@ impl App {
         shown.window.pre_present_notify();
         self.gpu.queue.present(texture);
         self.presented += 1;
-        self.frame_ms = 0.8 * self.frame_ms + 0.2 * start.elapsed().as_secs_f64() * 1e3;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        self.frame_ms = if self.presented == 1 {
+            ms
+        } else {
+            0.8 * self.frame_ms + 0.2 * ms
+        };
+        self.stats.add(ms, &self.live);
 
         if let Some(dir) = self.request.record.clone() {
             let path = dir.join(render::sequence::frame_file_name(
@@ -398,9 +435,14 @@ impl App {
         Ok(())
     }
 
-    /// Write the frame through `camera` at window size, as `cloth-vis render` writes its still.
+    /// Write the frame through `camera` (at `--screenshot-size` when given), as `cloth-vis
+    /// render` writes its still.
     fn write_image(&mut self, camera: &render::Camera, path: &Path) -> anyhow::Result<()> {
-        let image = self.live.capture(&self.gpu, camera)?;
+        let camera = match self.request.screenshot_size {
+            Some((w, h)) => self.orbit.camera(w, h),
+            None => *camera,
+        };
+        let image = self.live.capture(&self.gpu, &camera)?;
         let display = self.live.display().context("display mapping")?;
         let background = self.live.background();
         let is_exr = path
@@ -471,10 +513,19 @@ impl App {
         match key {
             Key::Named(NamedKey::Escape) => event_loop.exit(),
             Key::Named(NamedKey::Space) => {
-                self.playing = !self.playing && self.live.frame_count() > 1;
+                self.playing =
+                    !self.playing && (self.live.frame_count() > 1 || self.motion.is_some());
             }
-            Key::Named(NamedKey::ArrowRight) => self.live.step(1),
-            Key::Named(NamedKey::ArrowLeft) => self.live.step(-1),
+            Key::Named(NamedKey::ArrowRight) => {
+                if let Err(m) = self.advance(1) {
+                    self.status = m;
+                }
+            }
+            Key::Named(NamedKey::ArrowLeft) => {
+                if let Err(m) = self.advance(-1) {
+                    self.status = m;
+                }
+            }
             Key::Named(NamedKey::F12) => {
                 let (w, h) = self.size();
                 let camera = self.orbit.camera(w, h);
@@ -486,6 +537,10 @@ impl App {
                 "q" => event_loop.exit(),
                 "f" | "F" => event = Some(ViewEvent::Home),
                 "h" | "H" => self.overlay = !self.overlay,
+                "c" | "C" => event = Some(ViewEvent::NextCell),
+                "t" | "T" => {
+                    event = Some(ViewEvent::BtfPlain(!self.live.settings().btf_plain));
+                }
                 "p" | "P" => {
                     let (w, h) = self.size();
                     let camera = self.orbit.camera(w, h);
@@ -526,131 +581,52 @@ impl App {
             },
             _ => {}
         }
-        if let Some(event) = event {
-            let mut playing = self.playing;
-            if let Err(m) = self.live.apply(event, &mut self.orbit, &mut playing) {
-                self.status = m;
-            }
-            self.playing = playing;
+        if let Some(event) = event
+            && let Err(m) = self.apply(event)
+        {
+            self.status = m;
         }
+    }
+
+    /// Apply an input: the motion's own (play, pause, next cell, a `.cpca` frame) when a jump
+    /// map or a `.cpca` drives the pose, else the live scene's.
+    fn apply(&mut self, event: ViewEvent) -> Result<(), String> {
+        match (&mut self.motion, event) {
+            (Some(_), ViewEvent::Play) => self.playing = true,
+            (Some(_), ViewEvent::Pause) => self.playing = false,
+            (Some(Motion::JumpMap(j)), ViewEvent::NextCell) => {
+                j.next_cell().map_err(|e| e.to_string())?;
+            }
+            (Some(Motion::Cpca(c)), ViewEvent::Frame(f)) => {
+                let pose = c.seek(f).map_err(|e| e.to_string())?;
+                self.live.set_pose(0, &pose)?;
+            }
+            _ => {
+                let mut playing = self.playing;
+                let result = self.live.apply(event, &mut self.orbit, &mut playing);
+                self.playing = playing;
+                result?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Advance the animation `by` frames: the motion's next pose, or the scene's clip.
+    fn advance(&mut self, by: isize) -> Result<(), String> {
+        let pose = match &mut self.motion {
+            None => {
+                self.live.step(by);
+                return Ok(());
+            }
+            Some(Motion::Cpca(c)) => c.step(by),
+            Some(m @ Motion::JumpMap(_)) => m.next(),
+        };
+        let pose = pose.map_err(|e| e.to_string())?;
+        self.live.set_pose(0, &pose)
     }
 
     fn exposure(&self) -> f32 {
         self.live.display().map_or(0.0, |d| d.exposure_ev)
-    }
-}
-
-/// What the overlay asked for this frame.
-#[derive(Default)]
-struct UiRequests {
-    screenshot: bool,
-    home: bool,
-}
-
-/// The overlay's view of the state.
-struct Hud<'a> {
-    live: &'a mut LiveScene,
-    frame_ms: f64,
-    playing: &'a mut bool,
-    adaptive: bool,
-    status: &'a str,
-    requests: &'a mut UiRequests,
-}
-
-/// The overlay's level slider reaches this (k = 4,098 directions).
-const MAX_UI_LEVEL: u32 = 5;
-
-impl Hud<'_> {
-    /// The overlay: timings, effect toggles, level, environment, exposure, animation.
-    fn ui(&mut self, ctx: &egui::Context) {
-        let mono = |s: String| egui::RichText::new(s).monospace();
-        egui::Window::new("cloth-vis")
-            .default_pos([8.0, 8.0])
-            .resizable(false)
-            .show(ctx, |ui| {
-                let fps = if self.frame_ms > 0.0 { 1e3 / self.frame_ms } else { 0.0 };
-                ui.label(mono(format!("{:7.1} ms/frame {fps:6.1} fps", self.frame_ms)));
-                for t in self.live.times() {
-                    let line = format!("{:<18}{:8.2} ms", t.stage, t.millis);
-                    if t.fresh {
-                        ui.label(mono(line));
-                    } else {
-                        ui.label(mono(line).weak())
-                            .on_hover_text("not recomputed for this frame: its result is reused");
-                    }
-                }
-                ui.separator();
-                let mut settings = self.live.settings().clone();
-                for (i, (effect, on)) in settings.effects.iter_mut().enumerate() {
-                    let label = format!("{} {}", i + 1, effect.name());
-                    if *effect == Effect::Btf {
-                        // The btf stage draws its own picture (btf.png); not in this frame yet.
-                        ui.add_enabled(false, egui::Checkbox::new(on, label))
-                            .on_disabled_hover_text(
-                                "the BTF comparison is rendered by `cloth-vis render` into its \
-                                 own image; the viewer does not draw it yet",
-                            );
-                    } else {
-                        ui.checkbox(on, label);
-                    }
-                }
-                if self.live.has_lights() {
-                    let top = MAX_UI_LEVEL.max(settings.level);
-                    let k = lightsphere::direction_count(settings.level);
-                    ui.add(
-                        egui::Slider::new(&mut settings.level, 0..=top)
-                            .text(format!("level (k = {k})")),
-                    );
-                    if self.adaptive {
-                        ui.label("adaptive level: on");
-                    }
-                    ui.add(
-                        egui::Slider::new(&mut settings.rotation_deg, -180.0..=180.0)
-                            .text("environment turn (°)"),
-                    );
-                }
-                let mut ev = settings
-                    .exposure_ev
-                    .or_else(|| self.live.display().map(|d| d.exposure_ev))
-                    .unwrap_or(0.0);
-                if ui
-                    .add(egui::Slider::new(&mut ev, -10.0..=10.0).text("exposure (EV)"))
-                    .changed()
-                {
-                    settings.exposure_ev = Some(ev);
-                }
-                let frames = self.live.frame_count();
-                if frames > 1 {
-                    ui.horizontal(|ui| {
-                        let label = if *self.playing { "pause" } else { "play" };
-                        if ui.button(label).clicked() {
-                            *self.playing = !*self.playing;
-                        }
-                        ui.add(egui::Slider::new(&mut settings.frame, 0..=frames - 1).text("frame"));
-                    });
-                }
-                ui.horizontal(|ui| {
-                    if ui.button("frame object (F)").clicked() {
-                        self.requests.home = true;
-                    }
-                    if ui.button("screenshot (P)").clicked() {
-                        self.requests.screenshot = true;
-                    }
-                });
-                if !self.status.is_empty() {
-                    ui.label(self.status);
-                }
-                ui.collapsing("keys", |ui| {
-                    ui.label(
-                        "drag: orbit · right/middle drag: pan · wheel: zoom · F: frame object\n\
-                         1–9: toggle effect · +/−: level · [ ]: exposure · , .: turn environment\n\
-                         space: play/pause · ← →: step · P/F12: screenshot · H: overlay · Q/Esc: quit",
-                    );
-                });
-                if settings != *self.live.settings() {
-                    *self.live.settings_mut() = settings;
-                }
-            });
     }
 }
 
