@@ -234,6 +234,16 @@ impl ViewArgs {
         let mut cells = Vec::new();
         for path in std::iter::once(&clip).chain(&self.cell) {
             let (clip, _) = meshio::load_animation(path, &options)?;
+            if clip.frames.len() < 2 {
+                return Err(invalid(
+                    path,
+                    format!(
+                        "--jumpmap needs an animation (a glTF clip, an OBJ folder, a .npy); \
+                         this has {} frame(s)",
+                        clip.frames.len()
+                    ),
+                ));
+            }
             if let Some(first) = cells.first().and_then(|c: &Vec<Vec<glam::Vec3>>| c.first())
                 && clip.frames.first().map(Vec::len) != Some(first.len())
             {

@@ -69,6 +69,7 @@ pub(super) struct Hud<'a> {
     pub(super) motion: Option<&'a str>,
     pub(super) live: &'a mut LiveScene,
     pub(super) frame_ms: f64,
+    pub(super) unstaged_ms: f64,
     pub(super) playing: &'a mut bool,
     pub(super) adaptive: bool,
     pub(super) status: &'a str,
@@ -87,7 +88,14 @@ impl Hud<'_> {
             .resizable(false)
             .show(ctx, |ui| {
                 let fps = if self.frame_ms > 0.0 { 1e3 / self.frame_ms } else { 0.0 };
-                ui.label(mono(format!("{:7.1} ms/frame {fps:6.1} fps", self.frame_ms)));
+                ui.label(mono(format!("{:7.1} ms/frame {fps:6.1} fps", self.frame_ms)))
+                    .on_hover_text("the last presented frame (the viewer draws on demand)");
+                ui.label(mono(format!("{:<18}{:8.2} ms", "GPU + present", self.unstaged_ms)))
+                    .on_hover_text(
+                        "the last frame's time outside the stage timers: GPU work the stages \
+                         only submitted (the BTF's per-pixel reconstruction, shading), the \
+                         overlay and presenting",
+                    );
                 for t in self.live.times() {
                     let line = format!("{:<18}{:8.2} ms", t.stage, t.millis);
                     if t.fresh {

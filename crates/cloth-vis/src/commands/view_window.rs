@@ -33,8 +33,8 @@ pub fn run(request: ViewRequest) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("cloth-vis view renders on the GPU: {e}"))?;
     let mut live = LiveScene::new(request.scene.clone(), &gpu)?;
     for path in &request.environments {
-        let env = lightsphere::Environment::load(path)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        // The loader's errors name the file already.
+        let env = lightsphere::Environment::load(path)?;
         live.add_environment(path.display().to_string(), env);
     }
     let motion = match &request.motion {
@@ -93,6 +93,8 @@ struct App {
     cursor: (f64, f64),
     last_input: Instant,
     frame_ms: f64,
+    /// The last frame's time outside the stage timers.
+    unstaged_ms: f64,
     stats: FrameStats,
     controller: Option<LevelController>,
     motion: Option<Motion>,
@@ -124,6 +126,7 @@ impl App {
             cursor: (0.0, 0.0),
             last_input: Instant::now(),
             frame_ms: 0.0,
+            unstaged_ms: 0.0,
             stats: FrameStats::default(),
             controller,
             motion: None,
@@ -333,6 +336,7 @@ impl App {
             motion: motion_status.as_deref(),
             live: &mut self.live,
             frame_ms: self.frame_ms,
+            unstaged_ms: self.unstaged_ms,
             playing: &mut self.playing,
             adaptive: self.controller.is_some(),
             status: &self.status,
@@ -405,11 +409,19 @@ impl App {
         self.gpu.queue.present(texture);
         self.presented += 1;
         let ms = start.elapsed().as_secs_f64() * 1e3;
-        self.frame_ms = if self.presented == 1 {
-            ms
-        } else {
-            0.8 * self.frame_ms + 0.2 * ms
-        };
+        // The viewer draws on demand, so the last frame's own time is what the HUD shows (an
+        // average would carry the first frame's loading into every idle redraw); what the
+        // stage timers do not see (GPU work they only submitted, the overlay, presenting) is
+        // its own line.
+        self.frame_ms = ms;
+        let staged: f64 = self
+            .live
+            .times()
+            .iter()
+            .filter(|t| t.fresh)
+            .map(|t| t.millis)
+            .sum();
+        self.unstaged_ms = (ms - staged).max(0.0);
         self.stats.add(ms, &self.live);
 
         if let Some(dir) = self.request.record.clone() {

@@ -64,8 +64,9 @@ impl LiveScene {
             ViewEvent::Environment(i) => {
                 if i >= self.choices.len() {
                     return Err(format!(
-                        "there are {} environments (0: the scene's; add maps with --env)",
-                        self.choices.len()
+                        "environment {i} does not exist: the choices are 0..={} (0: the \
+                         scene's; add maps with --env)",
+                        self.choices.len() - 1
                     ));
                 }
                 self.settings.environment = i;
