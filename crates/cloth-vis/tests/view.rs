@@ -143,8 +143,29 @@ fn mean_diff(a: &Path, b: &Path) -> f64 {
     total as f64 / pa.len() as f64
 }
 
+/// The viewer's picture equals `want` within a mean of 1/255 (the target).
+fn assert_matches(shot: &Path, want: &Path, what: &str) {
+    let d = mean_diff(shot, want);
+    assert!(d <= 1.0, "mean difference {d} codes to {what} (> 1/255)");
+}
+
+/// The change was visible: the picture is more than `codes` away from `before`.
+fn assert_differs(shot: &Path, before: &Path, codes: f64, what: &str) {
+    let d = mean_diff(shot, before);
+    assert!(
+        d > codes,
+        "{what}: mean difference {d} codes, want > {codes}"
+    );
+}
+
 fn ready() -> bool {
     xvfb() && gpu_available()
+}
+
+/// A file under `../shared/data` when it and a window are available (else the skip rule).
+fn shared_and_ready(rel: &str) -> Option<PathBuf> {
+    let path = test_data::shared_file(rel)?;
+    ready().then_some(path)
 }
 
 #[test]
@@ -229,11 +250,7 @@ fn replayed_orbit_gives_the_expected_camera() {
         "turned",
         &scene_exposed(SHADOWED, -1, expected, "-4.0"),
     );
-    let d = mean_diff(&shot, &turned);
-    assert!(
-        d <= 1.0,
-        "mean difference {d} codes to the render from the expected eye"
-    );
+    assert_matches(&shot, &turned, "the render from the expected eye");
 }
 
 #[test]
@@ -245,15 +262,8 @@ fn an_animation_frame_is_lit_through_its_own_visibility() {
     let (scene, last) = render_still(dir.path(), "last", &scene_text(SHADOWED, -1, EYE));
     let (_, early) = render_still(dir.path(), "early", &scene_text(SHADOWED, 12, EYE));
     let (shot, _) = scripted(dir.path(), &scene, "frame12", "frame 12\n");
-    let d = mean_diff(&shot, &early);
-    assert!(
-        d <= 1.0,
-        "mean difference {d} codes to the still of frame 12"
-    );
-    assert!(
-        mean_diff(&shot, &last) > 2.0,
-        "frame 12 looks like the last frame"
-    );
+    assert_matches(&shot, &early, "the still of frame 12");
+    assert_differs(&shot, &last, 2.0, "frame 12 looks like the last frame");
 }
 
 #[test]
@@ -393,12 +403,9 @@ fn after<'a>(stdout: &'a str, key: &str) -> Option<&'a str> {
 
 #[test]
 fn a_cpca_streams_through_the_gpu_decoder_with_its_own_visibility() {
-    let Some(chicken) = test_data::shared_file("anim/chickenCrossing") else {
+    let Some(chicken) = shared_and_ready("anim/chickenCrossing") else {
         return;
     };
-    if !ready() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let cpca = dir.path().join("chicken.cpca");
     let out = common::cli(&[
@@ -422,15 +429,8 @@ fn a_cpca_streams_through_the_gpu_decoder_with_its_own_visibility() {
         stdout.contains("cpca frame 90 of 170 (GPU decoder)"),
         "{stdout}"
     );
-    let d = mean_diff(&shot, &later);
-    assert!(
-        d <= 1.0,
-        "mean difference {d} codes to the still of frame 90"
-    );
-    assert!(
-        mean_diff(&shot, &first) > 1.0,
-        "frame 90 looks like frame 0"
-    );
+    assert_matches(&shot, &later, "the still of frame 90");
+    assert_differs(&shot, &first, 1.0, "frame 90 looks like frame 0");
     // Playing advances one decoded frame per presented frame.
     let (_, stdout) = scripted(dir.path(), &scene, "play", "play\n");
     assert!(stdout.contains("cpca frame 1 of 170"), "{stdout}");
@@ -438,12 +438,9 @@ fn a_cpca_streams_through_the_gpu_decoder_with_its_own_visibility() {
 
 #[test]
 fn a_jump_map_plays_clip_frames_lit_through_their_own_visibility() {
-    let Some(chicken) = test_data::shared_file("anim/chickenCrossing") else {
+    let Some(chicken) = shared_and_ready("anim/chickenCrossing") else {
         return;
     };
-    if !ready() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let source = chicken.to_str().unwrap();
     let (scene, _) = render_still(dir.path(), "jump", &clip_scene(source, 0));
@@ -494,11 +491,7 @@ fn backend_switch_equals_the_render_through_that_backend() {
         + "\n[visibility]\nbackend = \"depth\"\ndepth_resolution = 128\n";
     let (_, want) = render_still(dir.path(), "depth", &depth);
     let (shot, _) = scripted(dir.path(), &scene, "to-depth", "backend depth 128\n");
-    let d = mean_diff(&shot, &want);
-    assert!(
-        d <= 1.0,
-        "mean difference {d} codes to the depth-backend render"
-    );
+    assert_matches(&shot, &want, "the depth-backend render");
 }
 
 /// The drape on the ground under a point light casting shadow volumes, light at `light`.
@@ -520,25 +513,15 @@ fn a_moved_point_light_equals_the_render_with_the_light_there() {
     let (scene, before) = render_still(dir.path(), "before", &point_light_scene([1.5, 2.5, 1.0]));
     let (_, want) = render_still(dir.path(), "after", &point_light_scene([-1.5, 2.0, -0.5]));
     let (shot, _) = scripted(dir.path(), &scene, "moved", "light -1.5 2 -0.5\n");
-    let d = mean_diff(&shot, &want);
-    assert!(
-        d <= 1.0,
-        "mean difference {d} codes to the render with the light moved"
-    );
-    assert!(
-        mean_diff(&shot, &before) > 1.0,
-        "moving the light changed nothing"
-    );
+    assert_matches(&shot, &want, "the render with the light moved");
+    assert_differs(&shot, &before, 1.0, "moving the light changed nothing");
 }
 
 #[test]
 fn another_environment_and_tone_curve_equal_the_render_with_them() {
-    let Some(venice) = test_data::shared_file("env/venice_sunset_1k.hdr") else {
+    let Some(venice) = shared_and_ready("env/venice_sunset_1k.hdr") else {
         return;
     };
-    if !ready() {
-        return;
-    }
     let dir = tempfile::tempdir().unwrap();
     let sky = scene_exposed(SHADOWED, -1, EYE, "-4.0");
     let (scene, _) = render_still(dir.path(), "sky", &sky);
@@ -563,11 +546,7 @@ fn another_environment_and_tone_curve_equal_the_render_with_them() {
         "--size",
         "160x120",
     ]);
-    let d = mean_diff(&shot, &want);
-    assert!(
-        d <= 1.0,
-        "mean difference {d} codes to the render under the map"
-    );
+    assert_matches(&shot, &want, "the render under the map");
     // The tone curve: clamp + γ 2.2 as the scene's [output] would set it.
     let (_, clamped) = render_still(
         dir.path(),
@@ -575,6 +554,5 @@ fn another_environment_and_tone_curve_equal_the_render_with_them() {
         &sky.replace("exposure = -4.0", "exposure = -4.0\ntone = \"clamp\""),
     );
     let (shot, _) = scripted(dir.path(), &scene, "tone", "tone clamp\n");
-    let d = mean_diff(&shot, &clamped);
-    assert!(d <= 1.0, "mean difference {d} codes to the clamped render");
+    assert_matches(&shot, &clamped, "the clamped render");
 }
