@@ -314,6 +314,23 @@ fn bad_scripts_and_flags_are_refused_naming_the_value() {
     );
     let e = run(&["demo", "--size", "0x10"]);
     assert!(e.contains("\"0\""), "{e}");
+    // A jump map needs an animation; a still mesh is refused by name.
+    let tri = dir.path().join("tri.obj");
+    std::fs::write(&tri, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let e = run(&[text(&tri), "--jumpmap"]);
+    assert!(
+        e.contains("tri.obj") && e.contains("needs an animation") && e.contains("1 frame"),
+        "{e}"
+    );
+    // A .cpca that is not one is named before any window or GPU work.
+    let cpca = dir.path().join("cut.cpca");
+    std::fs::write(&cpca, b"CPCA").unwrap();
+    let e = run(&[text(&cpca)]);
+    assert!(e.contains("cut.cpca"), "{e}");
+    // An --env map that does not exist is named once, before the GPU is asked for.
+    let e = run(&["demo", "--env", "/nonexistent/sky.hdr"]);
+    assert!(e.contains("/nonexistent/sky.hdr: cannot open"), "{e}");
+    assert!(!e.contains("GPU"), "{e}");
 }
 
 /// The cloth with the synthetic woven BTF beside plain texturing (the demo's `btf` effect,

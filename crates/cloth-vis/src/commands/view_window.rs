@@ -29,13 +29,23 @@ const IDLE_REFINE_AFTER: Duration = Duration::from_millis(300);
 
 /// Open the window and run until it closes (or the scripted frames are presented).
 pub fn run(request: ViewRequest) -> anyhow::Result<()> {
+    // The maps first: a bad file is named before the GPU and the scene are set up. (The
+    // loader's errors name the file.)
+    let environments = request
+        .environments
+        .iter()
+        .map(|path| {
+            Ok((
+                path.display().to_string(),
+                lightsphere::Environment::load(path)?,
+            ))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let gpu = GpuContext::new(&GpuOptions::default())
         .map_err(|e| anyhow::anyhow!("cloth-vis view renders on the GPU: {e}"))?;
     let mut live = LiveScene::new(request.scene.clone(), &gpu)?;
-    for path in &request.environments {
-        // The loader's errors name the file already.
-        let env = lightsphere::Environment::load(path)?;
-        live.add_environment(path.display().to_string(), env);
+    for (name, env) in environments {
+        live.add_environment(name, env);
     }
     let motion = match &request.motion {
         None => None,
