@@ -155,6 +155,37 @@ pub(crate) struct BtfScene {
 }
 
 impl BtfScene {
+    /// The fins of `chosen` (the BTF's objects) for `camera`'s eye, lit by `[btf]`'s light
+    /// (§5.7), when `[btf] fins` asks for them.
+    ///
+    /// # Errors
+    /// Silhouette extraction and upload errors.
+    pub(crate) fn fins_for(
+        &self,
+        scene: &Scene,
+        chosen: &[&WorldObject],
+        camera: &render::Camera,
+    ) -> Result<Option<crate::fins_stage::FinFrame>, Error> {
+        let desc = &scene.btf;
+        let (Some(f), Some(fin_renderer)) = (&desc.fins, &self.fins) else {
+            return Ok(None);
+        };
+        let (_, radius) = render::bounding_sphere(chosen.iter().flat_map(|o| &o.positions))
+            .unwrap_or((Vec3::ZERO, 1.0));
+        let look_fins = crate::fins_stage::FinLook::for_radius(radius, f.height, f.size);
+        let light = Light::Directional {
+            dir_to_light_world: Vec3::from(desc.light_dir),
+            radiance: Vec3::from(desc.radiance),
+        };
+        Ok(Some(crate::fins_stage::fin_frame(
+            fin_renderer,
+            chosen,
+            &light,
+            camera,
+            &look_fins,
+        )?))
+    }
+
     /// Loads what `[btf]` names.
     ///
     /// # Errors
@@ -317,21 +348,7 @@ impl BtfScene {
         let env_ms = env_start.elapsed().as_secs_f64() * 1e3;
         let mut params = RenderParams::default();
         params.uv_scale = Vec2::splat(desc.uv_scale);
-        let fins = match (&desc.fins, &self.fins) {
-            (Some(f), Some(fin_renderer)) => {
-                let (_, radius) = render::bounding_sphere(chosen.iter().flat_map(|o| &o.positions))
-                    .unwrap_or((Vec3::ZERO, 1.0));
-                let look_fins = crate::fins_stage::FinLook::for_radius(radius, f.height, f.size);
-                Some(crate::fins_stage::fin_frame(
-                    fin_renderer,
-                    &chosen,
-                    &light,
-                    &look.camera,
-                    &look_fins,
-                )?)
-            }
-            _ => None,
-        };
+        let fins = self.fins_for(scene, &chosen, &look.camera)?;
         let render_start = Instant::now();
         let with: Vec<(&BtfPca, &WorldObject)> =
             items.iter().map(|(m, _, o)| (&materials[*m], o)).collect();

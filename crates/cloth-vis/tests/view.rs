@@ -380,6 +380,26 @@ fn btf_and_plain_texture_equal_the_halves_of_the_render() {
     assert!(mean_diff(&with_btf, &plain) > 1.0);
 }
 
+#[test]
+fn btf_fins_follow_the_view_as_in_the_render() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let fins = btf_scene() + "fins = { source = \"synth:wool\" }\n";
+    let (scene, with_fins) = render_still(dir.path(), "fins", &fins);
+    let (_, bare) = render_still(dir.path(), "bare", &btf_scene());
+    let (left, left_bare) = (
+        dir.path().join("left.png"),
+        dir.path().join("left-bare.png"),
+    );
+    half(&with_fins.with_file_name("btf.png"), false, &left);
+    half(&bare.with_file_name("btf.png"), false, &left_bare);
+    let (shot, _) = scripted(dir.path(), &scene, "fins", "btf-plain off\n");
+    assert_matches(&shot, &left, "the BTF half of the render with fins");
+    assert_differs(&shot, &left_bare, 0.1, "the fins changed nothing");
+}
+
 /// A scene of one clip file (relative to the scene), explicit camera on the chicken.
 fn clip_scene(source: &str, frame: usize) -> String {
     format!(

@@ -2,9 +2,11 @@
 //! [`btf::render::BtfDraw`] passes in the viewer's own frame — the compressed BTF, or with
 //! the "plain" switch the same objects under plain texture mapping — while every other object
 //! stays Gouraud-shaded. The materials are uploaded once; under an environment, W per vertex is
-//! kept until the pose or the turn changes. Fins (§5.7) are not drawn live.
+//! kept until the pose or the turn changes. `[btf] fins` (§5.7) are extracted along the
+//! silhouettes of each drawn view, as `render` does, on the BTF only (not under the plain
+//! switch: the still's right half has none).
 
-use btf::render::{BtfDraw, GpuBtfRenderer, Light, RenderParams};
+use btf::render::{BtfDraw, FinDraw, GpuBtfRenderer, Light, RenderParams};
 use glam::{Vec2, Vec3};
 use gpu_context::GpuContext;
 use render::{Camera, Renderer};
@@ -68,7 +70,8 @@ impl LiveBtf {
 
     /// This frame's draws: each BTF object (or garment part) with its material, or its plain
     /// companion when `plain`, lit by `[btf]`'s light or by `environment` turned by
-    /// `rotation_deg` (W recomputed only when `pose` or the turn changed).
+    /// `rotation_deg` (W recomputed only when `pose` or the turn changed); and the fins of
+    /// this view when the scene asks for them and `plain` is off.
     #[allow(clippy::too_many_arguments)] // one frame's inputs
     pub(crate) fn draws(
         &mut self,
@@ -79,7 +82,7 @@ impl LiveBtf {
         environment: Option<&lightsphere::Environment>,
         pose: usize,
         rotation_deg: f32,
-    ) -> Result<Vec<BtfDraw>, Error> {
+    ) -> Result<(Vec<BtfDraw>, Vec<FinDraw>), Error> {
         let desc = &scene.btf;
         let chosen = chosen_objects(desc, objects)?;
         let items = split_into_parts(
@@ -143,6 +146,14 @@ impl LiveBtf {
             };
             draws.push(draw);
         }
-        Ok(draws)
+        let fins = if plain {
+            Vec::new()
+        } else {
+            self.scene_btf
+                .fins_for(scene, &chosen, camera)?
+                .map(|f| f.draws)
+                .unwrap_or_default()
+        };
+        Ok((draws, fins))
     }
 }

@@ -156,6 +156,7 @@ pub struct LiveScene {
     effects: FrameEffects,
     btf: Option<btf::LiveBtf>,
     btf_draws: Vec<::btf::render::BtfDraw>,
+    fin_draws: Vec<::btf::render::FinDraw>,
     renderer: Renderer,
     background: Background,
     start_camera: Camera,
@@ -283,6 +284,7 @@ impl LiveScene {
             effects,
             btf,
             btf_draws: Vec::new(),
+            fin_draws: Vec::new(),
             renderer,
             background,
             start_camera,
@@ -395,7 +397,12 @@ impl LiveScene {
     pub fn draw(&mut self, gpu: &GpuContext, camera: &Camera) -> Result<(), Error> {
         self.prepare(gpu, camera)?;
         let t = Instant::now();
-        let passes = passes(&self.effects, &self.btf_draws, &self.settings);
+        let passes = passes(
+            &self.effects,
+            &self.btf_draws,
+            &self.fin_draws,
+            &self.settings,
+        );
         self.renderer
             .draw_frame(&gpu.device, &gpu.queue, camera, self.background, &passes)?;
         record(
@@ -414,7 +421,12 @@ impl LiveScene {
     pub fn capture(&mut self, gpu: &GpuContext, camera: &Camera) -> Result<HdrImage, Error> {
         self.prepare(gpu, camera)?;
         let t = Instant::now();
-        let passes = passes(&self.effects, &self.btf_draws, &self.settings);
+        let passes = passes(
+            &self.effects,
+            &self.btf_draws,
+            &self.fin_draws,
+            &self.settings,
+        );
         let image =
             self.renderer
                 .render(&gpu.device, &gpu.queue, camera, self.background, &passes)?;
@@ -509,11 +521,12 @@ impl LiveScene {
             record(&mut self.times, stage.name(), millis);
         }
         self.btf_draws.clear();
+        self.fin_draws.clear();
         let mut except = Vec::new();
         if let Some(live_btf) = self.btf.as_mut().filter(|_| s.is_on(Effect::Btf)) {
             let t = Instant::now();
             except = btf::LiveBtf::names(&self.scene, &self.objects)?;
-            self.btf_draws = live_btf.draws(
+            (self.btf_draws, self.fin_draws) = live_btf.draws(
                 &self.scene,
                 &self.objects,
                 camera,
@@ -643,13 +656,16 @@ impl LiveScene {
     }
 }
 
-/// The frame passes of the effects switched on: the BTF draws, then the frame effects.
+/// The frame passes of the effects switched on: the BTF draws and their fins, then the frame
+/// effects.
 fn passes<'a>(
     effects: &'a FrameEffects,
     btf_draws: &'a [::btf::render::BtfDraw],
+    fin_draws: &'a [::btf::render::FinDraw],
     settings: &LiveSettings,
 ) -> Vec<&'a dyn FramePass> {
     let mut passes: Vec<&dyn FramePass> = btf_draws.iter().map(|d| d as &dyn FramePass).collect();
+    passes.extend(fin_draws.iter().map(|d| d as &dyn FramePass));
     passes.extend(effects.passes_where(
         settings.is_on(Effect::ShadowVolumes),
         settings.is_on(Effect::Translucency),
