@@ -112,6 +112,14 @@ impl FrameEffects {
         volumes.or(translucency).map(|p| p.as_vec3())
     }
 
+    /// Turn the shadow volumes' sun (if any) with the environment by `turn_deg` on top of
+    /// the scene's rotation.
+    pub fn turn_sun(&mut self, turn_deg: f32) {
+        if let Some(v) = self.volumes.as_mut() {
+            v.turn_sun(turn_deg);
+        }
+    }
+
     /// Move the first point light of every effect that has one to `position`.
     pub fn set_point_light(&mut self, position: glam::Vec3) {
         let p = position.as_dvec3();

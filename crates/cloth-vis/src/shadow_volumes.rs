@@ -39,6 +39,9 @@ pub struct ShadowVolumeStage {
     effect: StencilShadows,
     casters: Vec<Caster>,
     lights: Vec<(Light, Vec3)>,
+    /// The sky's sun among `lights`: its index and its direction at the scene's own
+    /// environment rotation (a viewer's turn is applied on top).
+    suns: Vec<(usize, DVec3)>,
     boundary: Option<SmoothBoundary>,
     volumes: Vec<ShadowVolume>,
     scratch: ShadowVolume,
@@ -134,8 +137,20 @@ impl ShadowVolumeStage {
             "lod": desc.lod,
             "setup_ms": start.elapsed().as_secs_f64() * 1e3,
         });
+        let suns = scene
+            .shadow_volumes
+            .lights
+            .iter()
+            .zip(&lights)
+            .enumerate()
+            .filter_map(|(i, (desc, (light, _)))| match light {
+                Light::Directional(d) if desc.sun => Some((i, *d)),
+                _ => None,
+            })
+            .collect();
         Ok(Self {
             effect,
+            suns,
             volumes: (0..lights.len()).map(|_| ShadowVolume::new()).collect(),
             casters,
             lights,
@@ -243,6 +258,16 @@ impl ShadowVolumeStage {
             Light::Point(p) => Some(*p),
             Light::Directional(_) => None,
         })
+    }
+
+    /// Turn the sky's sun with the environment by `turn_deg` about +Y on top of the scene's
+    /// own rotation (a viewer's environment turn: the sun's volumes follow the sky that its
+    /// light was taken out of). The next [`ShadowVolumeStage::prepare`] builds from there.
+    pub fn turn_sun(&mut self, turn_deg: f32) {
+        let turn = crate::lighting::environment_rotation(turn_deg).as_dquat();
+        for &(i, base) in &self.suns {
+            self.lights[i].0 = Light::Directional(if turn_deg == 0.0 { base } else { turn * base });
+        }
     }
 
     /// Move the first point light to `position` (a viewer's light control); the next

@@ -517,6 +517,28 @@ fn a_jump_map_plays_clip_frames_lit_through_their_own_visibility() {
     panic!("three consecutive blend frames at the end of the run");
 }
 
+/// The drape under the sky whose sun casts shadow volumes onto a ground, the environment
+/// turned by `rotation_deg`, at a fixed exposure (a turn must not re-measure it).
+fn sun_scene(rotation_deg: f32) -> String {
+    scene_exposed(r#""lighting", "shadow-volumes""#, -1, EYE, "-3.5").replace(
+        "[environment]\nsource = \"synth:sky\"\n",
+        &format!("[environment]\nsource = \"synth:sky\"\nrotation_deg = {rotation_deg:.1}\n"),
+    ) + "\n[ground]\nsize = 5.0\ncells = 16\n\n[shadow_volumes]\n\n[[shadow_volumes.light]]\nsun = true\n"
+}
+
+#[test]
+fn turning_the_sky_turns_its_suns_shadows() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (scene, before) = render_still(dir.path(), "sun0", &sun_scene(0.0));
+    let (_, want) = render_still(dir.path(), "sun90", &sun_scene(90.0));
+    let (shot, _) = scripted(dir.path(), &scene, "turned", "rotation 90\n");
+    assert_matches(&shot, &want, "the render with the sky turned by 90°");
+    assert_differs(&shot, &before, 1.0, "turning the sky moved nothing");
+}
+
 #[test]
 fn backend_switch_equals_the_render_through_that_backend() {
     if !ready() {

@@ -501,6 +501,13 @@ impl LiveScene {
             self.light(gpu, &key)?;
             self.lit = Some(key);
         }
+        // The sun of the shadow volumes turns with the sky it was taken from (the scene's
+        // map only: another map has no such sun, and its light stays where the scene put it).
+        self.effects.turn_sun(if s.environment == 0 {
+            s.rotation_deg
+        } else {
+            0.0
+        });
         if let Some(p) = s.point_light
             && self.effects.point_light() != Some(p)
         {
