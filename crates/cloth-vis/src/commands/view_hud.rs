@@ -234,7 +234,7 @@ impl Hud<'_> {
                     ui.label(
                         "drag: orbit · right/middle drag: pan · wheel: zoom · F: frame object\n\
                          1–9: toggle effect · T: BTF / plain texture · +/−: level · [ ]: exposure · , .: turn environment\n\
-                         space: play/pause · ← →: step · P/F12: screenshot · H: overlay · Q/Esc: quit",
+                         space: play/pause · ← →: step · P/F12: PNG screenshot · E: EXR (linear) · H: overlay · Q/Esc: quit",
                     );
                 });
                 if settings != *self.live.settings() {

@@ -443,7 +443,7 @@ impl App {
             self.write_image(&camera, &path)?;
         }
         if requests.screenshot {
-            self.key_screenshot(&camera)?;
+            self.key_screenshot(&camera, "png")?;
         }
         if requests.home {
             self.orbit = Orbit::from_camera(&self.live.start_camera(), self.live.bounds());
@@ -478,10 +478,12 @@ impl App {
         Ok(())
     }
 
-    fn key_screenshot(&mut self, camera: &render::Camera) -> anyhow::Result<()> {
+    /// Write the current view as `cloth-vis-NNNN.EXT` in the working folder (`png`: the
+    /// display mapping; `exr`: linear radiance), at `--screenshot-size` or the window's.
+    fn key_screenshot(&mut self, camera: &render::Camera, ext: &str) -> anyhow::Result<()> {
         let path = loop {
             self.screenshots += 1;
-            let p = PathBuf::from(format!("cloth-vis-{:04}.png", self.screenshots));
+            let p = PathBuf::from(format!("cloth-vis-{:04}.{ext}", self.screenshots));
             if !p.exists() {
                 break p;
             }
@@ -489,6 +491,15 @@ impl App {
         self.write_image(camera, &path)?;
         self.status = format!("wrote {}", path.display());
         Ok(())
+    }
+
+    /// A screenshot key: the file, or why not, in the overlay's status line.
+    fn screenshot_key(&mut self, ext: &str) {
+        let (w, h) = self.size();
+        let camera = self.orbit.camera(w, h);
+        if let Err(e) = self.key_screenshot(&camera, ext) {
+            self.status = format!("screenshot failed: {e:#}");
+        }
     }
 
     /// Adaptive level (paper 000 §4.2): while the animation plays, the controller fits the
@@ -548,13 +559,7 @@ impl App {
                     self.status = m;
                 }
             }
-            Key::Named(NamedKey::F12) => {
-                let (w, h) = self.size();
-                let camera = self.orbit.camera(w, h);
-                if let Err(e) = self.key_screenshot(&camera) {
-                    self.status = format!("screenshot failed: {e:#}");
-                }
-            }
+            Key::Named(NamedKey::F12) => self.screenshot_key("png"),
             Key::Character(c) => match c.as_str() {
                 "q" => event_loop.exit(),
                 "f" | "F" => event = Some(ViewEvent::Home),
@@ -563,13 +568,8 @@ impl App {
                 "t" | "T" => {
                     event = Some(ViewEvent::BtfPlain(!self.live.settings().btf_plain));
                 }
-                "p" | "P" => {
-                    let (w, h) = self.size();
-                    let camera = self.orbit.camera(w, h);
-                    if let Err(e) = self.key_screenshot(&camera) {
-                        self.status = format!("screenshot failed: {e:#}");
-                    }
-                }
+                "p" | "P" => self.screenshot_key("png"),
+                "e" | "E" => self.screenshot_key("exr"),
                 "+" | "=" => {
                     event = Some(ViewEvent::Level((self.live.settings().level + 1).min(6)))
                 }
