@@ -121,12 +121,13 @@ pub struct DecompositionCost {
 /// The environment binned per vertex for one object and visibility: built once (visibility,
 /// transfer, cube map), then W for any turn of the environment ([`EnvBinner::weights`]) or
 /// the decomposition of all turns ([`EnvBinner::decompose`]) without recomputing visibility.
-pub struct EnvBinner<'a> {
-    update: Box<dyn Fn(f32) -> Result<Vec<EnvLightWeights>, Error> + 'a>,
+/// It owns what a turn needs (a viewer keeps one per pose and turns it every frame).
+pub struct EnvBinner {
+    update: Box<dyn Fn(f32) -> Result<Vec<EnvLightWeights>, Error> + Send>,
     cost: EnvCost,
 }
 
-impl std::fmt::Debug for EnvBinner<'_> {
+impl std::fmt::Debug for EnvBinner {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("EnvBinner")
             .field("cost", &self.cost)
@@ -134,7 +135,7 @@ impl std::fmt::Debug for EnvBinner<'_> {
     }
 }
 
-impl<'a> EnvBinner<'a> {
+impl EnvBinner {
     /// The visibility of `object` (with UVs) by `visibility`, in the tangent frames of its UVs,
     /// for `env` (already on the object's up axis) turning about `up`.
     ///
@@ -143,7 +144,7 @@ impl<'a> EnvBinner<'a> {
     pub fn new(
         pca: &BtfPca,
         object: &WorldObject,
-        env: &'a lightsphere::Environment,
+        env: &lightsphere::Environment,
         up: Vec3,
         visibility: EnvVisibility,
     ) -> Result<Self, Error> {
@@ -173,75 +174,79 @@ impl<'a> EnvBinner<'a> {
             render_ms: 0.0,
             decomposition: None,
         };
-        let update: Box<dyn Fn(f32) -> Result<Vec<EnvLightWeights>, Error> + 'a> = match visibility
-        {
-            EnvVisibility::Matrix { level } => {
-                let sphere = lightsphere::Lightsphere::new(level)?;
-                let mut engine = occlusion_gpu::VisibilityEngine::cpu(
-                    occlusion_gpu::VisibilityParams::default(),
-                );
-                let m = engine.compute(&scene, &sphere)?;
-                cost.visibility_ms = start.elapsed().as_secs_f64() * 1e3;
-                cost.directions = sphere.len();
-                let omegas: Vec<f32> = sphere.solid_angles().iter().map(|&w| w as f32).collect();
-                let start = Instant::now();
-                let transfer = EnvTransfer::build(
-                    pca.sampling(),
-                    &frames,
-                    sphere.directions(),
-                    &omegas,
-                    |i, j| m.is_visible(i, j),
-                );
-                cost.transfer_ms = start.elapsed().as_secs_f64() * 1e3;
-                Box::new(move |deg| {
-                    let lookup = if deg == 0.0 {
-                        sphere.clone()
-                    } else {
-                        sphere.try_rotated(turn(deg).inverse())?
-                    };
-                    let radiance =
-                        env.radiance_per_direction(&lookup, lightsphere::RadianceMethod::CellMean)?;
-                    let mut w = Vec::new();
-                    transfer.update(&radiance, &mut w);
-                    Ok(w)
-                })
-            }
-            EnvVisibility::Maps { model } => {
-                let layout = std::sync::Arc::new(hemicube::PixelLayout::new(
-                    model,
-                    hemicube::FormFactorRule::Exact,
-                )?);
-                let caster = occlusion_gpu::RayCaster::new(&scene)?;
-                let map_frames = frames
-                    .iter()
-                    .map(|[t, _, n]| {
-                        (*n != Vec3::ZERO)
-                            .then(|| hemicube::VertexFrame::from_normal_tangent(*n, *t))
+        let update: Box<dyn Fn(f32) -> Result<Vec<EnvLightWeights>, Error> + Send> =
+            match visibility {
+                EnvVisibility::Matrix { level } => {
+                    let sphere = lightsphere::Lightsphere::new(level)?;
+                    let mut engine = occlusion_gpu::VisibilityEngine::cpu(
+                        occlusion_gpu::VisibilityParams::default(),
+                    );
+                    let m = engine.compute(&scene, &sphere)?;
+                    cost.visibility_ms = start.elapsed().as_secs_f64() * 1e3;
+                    cost.directions = sphere.len();
+                    let omegas: Vec<f32> =
+                        sphere.solid_angles().iter().map(|&w| w as f32).collect();
+                    let start = Instant::now();
+                    let transfer = EnvTransfer::build(
+                        pca.sampling(),
+                        &frames,
+                        sphere.directions(),
+                        &omegas,
+                        |i, j| m.is_visible(i, j),
+                    );
+                    cost.transfer_ms = start.elapsed().as_secs_f64() * 1e3;
+                    let env = env.clone();
+                    Box::new(move |deg| {
+                        let lookup = if deg == 0.0 {
+                            sphere.clone()
+                        } else {
+                            sphere.try_rotated(turn(deg).inverse())?
+                        };
+                        let radiance = env.radiance_per_direction(
+                            &lookup,
+                            lightsphere::RadianceMethod::CellMean,
+                        )?;
+                        let mut w = Vec::new();
+                        transfer.update(&radiance, &mut w);
+                        Ok(w)
                     })
-                    .collect();
-                let (maps, _) = hemicube::build_with_frames(
-                    &caster,
-                    layout,
-                    &hemicube::BuildParams::default(),
-                    map_frames,
-                    &|_| {},
-                );
-                cost.visibility_ms = start.elapsed().as_secs_f64() * 1e3;
-                cost.directions = maps.layout().len();
-                let channel = hemicube::BtfLightChannel::new(maps.layout(), pca.sampling());
-                let mirrored: Vec<bool> = tangents.iter().map(|t| t.w < 0.0).collect();
-                // The seed's look-up: a power-conserving cube map matched to the maps (the
-                // resolution `hemicube` measured best), turned by rotating the look-up.
-                let cube = hemicube::CubeMap::from_environment(
-                    env,
-                    hemicube::lighting::matched_cube_resolution(&maps),
-                );
-                Box::new(move |deg| {
-                    let back = turn(deg).inverse();
-                    Ok(channel.light_weights(&maps, &mirrored, |d| cube.lookup(back * d)))
-                })
-            }
-        };
+                }
+                EnvVisibility::Maps { model } => {
+                    let layout = std::sync::Arc::new(hemicube::PixelLayout::new(
+                        model,
+                        hemicube::FormFactorRule::Exact,
+                    )?);
+                    let caster = occlusion_gpu::RayCaster::new(&scene)?;
+                    let map_frames = frames
+                        .iter()
+                        .map(|[t, _, n]| {
+                            (*n != Vec3::ZERO)
+                                .then(|| hemicube::VertexFrame::from_normal_tangent(*n, *t))
+                        })
+                        .collect();
+                    let (maps, _) = hemicube::build_with_frames(
+                        &caster,
+                        layout,
+                        &hemicube::BuildParams::default(),
+                        map_frames,
+                        &|_| {},
+                    );
+                    cost.visibility_ms = start.elapsed().as_secs_f64() * 1e3;
+                    cost.directions = maps.layout().len();
+                    let channel = hemicube::BtfLightChannel::new(maps.layout(), pca.sampling());
+                    let mirrored: Vec<bool> = tangents.iter().map(|t| t.w < 0.0).collect();
+                    // The seed's look-up: a power-conserving cube map matched to the maps (the
+                    // resolution `hemicube` measured best), turned by rotating the look-up.
+                    let cube = hemicube::CubeMap::from_environment(
+                        env,
+                        hemicube::lighting::matched_cube_resolution(&maps),
+                    );
+                    Box::new(move |deg| {
+                        let back = turn(deg).inverse();
+                        Ok(channel.light_weights(&maps, &mirrored, |d| cube.lookup(back * d)))
+                    })
+                }
+            };
         Ok(Self { update, cost })
     }
 

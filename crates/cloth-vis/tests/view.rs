@@ -400,6 +400,37 @@ fn btf_fins_follow_the_view_as_in_the_render() {
     assert_differs(&shot, &left_bare, 0.1, "the fins changed nothing");
 }
 
+#[test]
+fn a_turned_sky_relights_the_btf_through_the_same_visibility() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let env_btf = |rotation: &str| {
+        btf_scene().replace(
+            "[environment]\nsource = \"synth:sky\"\n",
+            &format!("[environment]\nsource = \"synth:sky\"\nrotation_deg = {rotation}\n"),
+        ) + "illumination = \"environment\"\nlevel = 2\n"
+    };
+    let (scene, before) = render_still(dir.path(), "env0", &env_btf("0.0"));
+    let (_, turned) = render_still(dir.path(), "env120", &env_btf("120.0"));
+    let (left, left_before) = (dir.path().join("left.png"), dir.path().join("left0.png"));
+    half(&turned.with_file_name("btf.png"), false, &left);
+    half(&before.with_file_name("btf.png"), false, &left_before);
+    let (shot, _) = scripted(dir.path(), &scene, "turned", "rotation 120\n");
+    assert_matches(
+        &shot,
+        &left,
+        "the BTF half of the render with the sky turned 120°",
+    );
+    assert_differs(
+        &shot,
+        &left_before,
+        0.5,
+        "turning the sky left the BTF as it was",
+    );
+}
+
 /// A scene of one clip file (relative to the scene), explicit camera on the chicken.
 fn clip_scene(source: &str, frame: usize) -> String {
     format!(

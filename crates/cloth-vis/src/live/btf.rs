@@ -1,10 +1,11 @@
 //! The `btf` effect drawn live (thesis §5.5, Fig. 5.16): the scene's BTF objects as
 //! [`btf::render::BtfDraw`] passes in the viewer's own frame — the compressed BTF, or with
 //! the "plain" switch the same objects under plain texture mapping — while every other object
-//! stays Gouraud-shaded. The materials are uploaded once; under an environment, W per vertex is
-//! kept until the pose or the turn changes. `[btf] fins` (§5.7) are extracted along the
-//! silhouettes of each drawn view, as `render` does, on the BTF only (not under the plain
-//! switch: the still's right half has none).
+//! stays Gouraud-shaded. The materials are uploaded once. Under an environment, visibility and
+//! transfer are computed once per pose ([`crate::btf_env::EnvBinner`]) and a turn only updates
+//! W from the turned look-up. `[btf] fins` (§5.7) are extracted along the silhouettes of each
+//! drawn view, as `render` does, on the BTF only (not under the plain switch: the still's right
+//! half has none).
 
 use btf::render::{BtfDraw, FinDraw, GpuBtfRenderer, Light, RenderParams};
 use glam::{Vec2, Vec3};
@@ -17,8 +18,14 @@ use crate::btf_stage::{btf_mesh, tangents_of};
 use crate::object::WorldObject;
 use crate::scene::{BtfIllumination, Scene};
 
-/// W per drawn item, for (pose, turn bits).
-type EnvCache = ((usize, u32), Vec<Vec<btf::env::EnvLightWeights>>);
+/// The environment binned per drawn item for one pose (visibility and transfer done), and W
+/// per item at one turn.
+struct EnvCache {
+    pose: usize,
+    binners: Vec<crate::btf_env::EnvBinner>,
+    turn_bits: u32,
+    weights: Vec<Vec<btf::env::EnvLightWeights>>,
+}
 
 /// The scene's BTF materials on the GPU, and the environment weights of the current pose.
 pub(crate) struct LiveBtf {
@@ -101,34 +108,43 @@ impl LiveBtf {
                 });
             }
             (BtfIllumination::Environment, Some(env)) => {
-                let key = (pose, rotation_deg.to_bits());
-                if self.env.as_ref().is_none_or(|(k, _)| *k != key) {
-                    let lighting = crate::btf_env::EnvLighting {
-                        env,
-                        up: Vec3::Y,
-                        rotation_deg,
-                        visibility: match desc.maps {
-                            Some(res) => crate::btf_env::EnvVisibility::Maps {
-                                model: hemicube::Model::Hemicube { res },
-                            },
-                            None => crate::btf_env::EnvVisibility::Matrix { level: desc.level },
+                if self.env.as_ref().is_none_or(|c| c.pose != pose) {
+                    let visibility = match desc.maps {
+                        Some(res) => crate::btf_env::EnvVisibility::Maps {
+                            model: hemicube::Model::Hemicube { res },
                         },
-                        decompose: None,
+                        None => crate::btf_env::EnvVisibility::Matrix { level: desc.level },
                     };
-                    let ws = items
+                    let binners = items
                         .iter()
                         .map(|(m, o, _)| {
-                            crate::btf_env::env_weights(
+                            crate::btf_env::EnvBinner::new(
                                 &self.scene_btf.materials[*m],
                                 chosen[*o],
-                                &lighting,
+                                env,
+                                Vec3::Y,
+                                visibility,
                             )
-                            .map(|(w, _)| w)
                         })
                         .collect::<Result<Vec<_>, _>>()?;
-                    self.env = Some((key, ws));
+                    self.env = Some(EnvCache {
+                        pose,
+                        binners,
+                        // Not a turn's bits: the weights below are computed.
+                        turn_bits: f32::NAN.to_bits(),
+                        weights: Vec::new(),
+                    });
                 }
-                self.env.as_ref().map(|(_, ws)| ws)
+                let cache = self.env.as_mut().expect("binned above");
+                if cache.turn_bits != rotation_deg.to_bits() {
+                    cache.weights = cache
+                        .binners
+                        .iter()
+                        .map(|b| b.weights(rotation_deg))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    cache.turn_bits = rotation_deg.to_bits();
+                }
+                Some(&cache.weights)
             }
         };
         let light = Light::Directional {
