@@ -136,5 +136,7 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         }
         rgb += b[c] * texture;
     }
-    return vec4<f32>(frame.radiance.xyz * rgb, 1.0);
+    // A truncated PCA can ring slightly below zero in dark texels; radiance cannot be
+    // negative (the CPU reference clamps alike).
+    return vec4<f32>(max(frame.radiance.xyz * rgb, vec3<f32>(0.0)), 1.0);
 }

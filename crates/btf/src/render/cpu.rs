@@ -103,7 +103,11 @@ fn render_shaded(
             for (px, frag) in row.iter_mut().zip(frags) {
                 if let Some(f) = frag {
                     let rgb = shade_fragment(pca, mesh, shading, f, params.uv_scale);
-                    *px = (radiance * Vec3::from_array(rgb)).to_array();
+                    // A truncated PCA rings slightly below zero in dark texels: radiance
+                    // is clamped at 0, as the GPU shader does.
+                    *px = (radiance * Vec3::from_array(rgb))
+                        .max(Vec3::ZERO)
+                        .to_array();
                 }
             }
         });
