@@ -14,9 +14,13 @@
 //!   live ray of a 64-bit mask is slab-tested; a ray leaves the mask at its first hit. This is
 //!   the CPU counterpart of the seed's per-direction pass (paper 000 §3.2), without its
 //!   resolution limit.
-//! * [`CpuMethod::Fans`]: the rays of one vertex share its origin, so its directions (split
-//!   once into compact fans of 64, [`fan_groups`]) walk the BVH together, lanes below the
-//!   tangent plane masked off, with a common-origin triangle test (the `fan` module).
+//! * [`CpuMethod::Fans`]: the rays of one vertex share its origin, so its directions walk
+//!   the BVH together in fans of up to 64, with a common-origin triangle test (the `fan`
+//!   module). The directions are ordered once along the recursive median split of
+//!   [`fan_groups`] (neighbours in that order are neighbours on the sphere); each vertex
+//!   keeps those above its tangent plane and cuts them into ⌈n / 64⌉ equal runs, one fan
+//!   each — 2.9 fans of 43 lanes per bunny vertex at k = 258, where fixed fans masked by the
+//!   tangent plane took 4.4 fans of 29 live lanes (7 % slower).
 //! * [`CpuMethod::SingleRays`]: one any-hit traversal per ray of `obvhs`'s compressed 8-wide
 //!   BVH (CWBVH), with a per-direction shadow cache (the last blocking triangle of the chunk
 //!   is tested first). Kept as the independent cross-check: a test asserts all three give the
@@ -24,14 +28,15 @@
 //!
 //! [`CpuMethod::Auto`] (the default) takes fans when a call computes at least
 //! [`FAN_MIN_COLUMNS`] columns and packets below. Measured on the full bunny (35,947
-//! vertices, BVH build included, `benches/visibility.rs`): packets 35.6 / 58.9 / 154 / 502 /
-//! 1,818 ms at k = 6 / 18 / 66 / 258 / 1026, fans 44.1 / 71.8 / 158 / 417 / 1,133 ms, single
-//! rays 734 ms at k = 258. With few directions a vertex's fan is nearly empty and the
-//! per-fan set-up dominates; with many, the shared origin pays. Same M: at k = 258 no entry
-//! of the 9.3 M differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing
-//! rays). A per-direction uniform grid of the projected triangles was also tried and dropped:
-//! its per-direction fill (∝ triangles × k) cost more than the rays it saved (1.7× slower
-//! than single rays).
+//! vertices, BVH build included, best of 9 runs on 2 threads): packets 70.6 / 179 / 560 /
+//! 2,021 ms at k = 18 / 66 / 258 / 1026, fans 74.3 / 132 / 316 / 824 ms (before the
+//! per-vertex runs, slabs and AVX2 of issue #20: 427 / 1,171 ms at k = 258 / 1026 in the
+//! same session). With few directions a vertex's fan is nearly empty and the per-fan set-up
+//! dominates; with many, the shared origin pays. Same M: at k = 258 no entry of the 9.3 M
+//! differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing rays). A
+//! per-direction uniform grid of the projected triangles was also tried and dropped: its
+//! per-direction fill (∝ triangles × k) cost more than the rays it saved (1.7× slower than
+//! single rays).
 //!
 //! BVH crate: `obvhs` 0.4 over `bvh` 0.13. `bvh` is a binary BVH on nalgebra whose
 //! traversal collects candidate shapes per ray; `obvhs` builds BVHs by PLOC with reinsertion
@@ -74,18 +79,18 @@ pub enum CpuMethod {
     /// default: the faster of the two on either side).
     #[default]
     Auto,
-    /// Packets of up to 64 parallel rays through a binary BVH (faster for k ≤ 66).
+    /// Packets of up to 64 parallel rays through a binary BVH (faster for k ≤ 18).
     Packets,
     /// One traversal per ray of an 8-wide compressed BVH, with a shadow cache.
     SingleRays,
     /// Fans: each vertex's directions in fans of up to 64 from its origin (faster for
-    /// k ≥ 258).
+    /// k ≥ 66).
     Fans,
 }
 
-/// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 66 (packets
-/// 3 % faster) and k = 258 (fans 1.2× faster).
-pub const FAN_MIN_COLUMNS: usize = 128;
+/// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 18 (packets
+/// 5 % faster) and k = 66 (fans 1.36× faster).
+pub const FAN_MIN_COLUMNS: usize = 32;
 
 impl CpuMethod {
     /// The traversal this method runs for a call computing `columns` columns.
@@ -654,9 +659,10 @@ fn bvh_columns(
     scatter_chunks(&order, ROWS_PER_CHUNK, chunks, columns, bits, words_per_row)
 }
 
-/// [`compute_columns`] with fans ([`CpuMethod::Fans`]): the columns' directions split once
-/// into fans ([`fan_groups`]), every vertex traces each fan from its origin with the lanes
-/// below its tangent plane masked off; rows in Morton order, [`ROWS_PER_CHUNK`] per task.
+/// [`compute_columns`] with fans ([`CpuMethod::Fans`]): the columns' directions ordered
+/// once along [`fan_groups`]' split; every vertex takes those above its tangent plane in that
+/// order and traces them from its origin in ⌈n / 64⌉ equal runs, one fan each; rows in
+/// Morton order, [`ROWS_PER_CHUNK`] per task.
 fn fan_columns(
     prepared: &Prepared,
     tracer: &FanTracer,
@@ -671,25 +677,44 @@ fn fan_columns(
         ticker,
     } = target;
     let dirs = &directions[columns.clone()];
-    let groups = fan_groups(dirs);
-    let fans: Vec<RayFan> = groups.iter().map(|g| RayFan::from_group(dirs, g)).collect();
+    // The directions in the order of their recursive median split (`fan_groups`): neighbours
+    // in this order are neighbours on the sphere.
+    let curve: Vec<u32> = fan_groups(dirs)
+        .into_iter()
+        .flatten()
+        .filter(|&i| i != u32::MAX)
+        .collect();
+    let curve_dirs: Vec<Vec3> = curve.iter().map(|&i| dirs[i as usize]).collect();
     let order = morton_order(prepared);
     let chunks: Vec<(Vec<u32>, u64)> = order
         .par_chunks(ROWS_PER_CHUNK)
         .map(|rows| {
             let mut out = vec![0u32; rows.len() * words_per_row];
             let mut rays = 0u64;
+            let mut facing: Vec<u32> = Vec::with_capacity(curve.len());
+            let mut fan = RayFan::new();
             for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
                 let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
                     continue;
                 };
-                for (group, fan) in groups.iter().zip(&fans) {
-                    let mask = fan.facing(normal.into());
-                    rays += u64::from(mask.count_ones());
-                    let mut open = tracer.unoccluded(origin, fan, mask, span.max_t);
+                let normal = Vec3::from(normal);
+                facing.clear();
+                facing.extend(
+                    (0..curve.len() as u32).filter(|&c| normal.dot(curve_dirs[c as usize]) > 0.0),
+                );
+                rays += facing.len() as u64;
+                let count = facing.len().div_ceil(crate::fan::FAN_SIZE);
+                for f in 0..count {
+                    let run = &facing[f * facing.len() / count..(f + 1) * facing.len() / count];
+                    fan.clear();
+                    for &c in run {
+                        fan.push(curve_dirs[c as usize]);
+                    }
+                    let mut open = tracer.unoccluded(origin, &fan, fan.full_mask(), span.max_t);
                     while open != 0 {
-                        let j = columns.start + group[open.trailing_zeros() as usize] as usize;
+                        let lane = open.trailing_zeros() as usize;
                         open &= open - 1;
+                        let j = columns.start + curve[run[lane] as usize] as usize;
                         out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
                     }
                 }

@@ -14,7 +14,18 @@
 //! * otherwise each live group is slab-tested and the child's mask narrows; the child whose
 //!   centre is nearer the origin is visited first (near occluders end lanes early: 1.1–1.5×
 //!   faster than ordering along the fan's mean direction, which the nearest point of the box
-//!   or the entry distance of the interval test also lose to).
+//!   or the entry distance of the interval test also lose to);
+//! * every subtree of at most 1,024 triangles also carries a [`Slab`], the two planes along
+//!   its area-weighted normal that hold its triangles: a lane whose ray enters and leaves the
+//!   box on the same side of the slab is dropped. A surface patch is much thinner than its
+//!   box, and the rays that graze the surface near their origin cross the boxes of the
+//!   patches beside it: on the bunny at k = 258 leaf slabs alone took 5 % off, slabs up to
+//!   128 / 512 / 1,024 / 4,096 triangles 12 / 16 / 17 / 17 %.
+//!
+//! Where the CPU has AVX2 (checked at run time) the groups are eight lanes wide (the `avx2`
+//! module): the same formulas in the same operand order, no fused multiply-add, so every
+//! lane's answer is bit for bit the four-lane one (a unit test compares them); 5–8 % faster
+//! on the bunny at k = 258 (the per-group loops are under half of the time).
 //!
 //! The triangle test uses the common origin o: with a = v₀ − o, b = v₁ − o, c = v₂ − o, the
 //! edge normals n₀ = b × c, n₁ = c × a, n₂ = a × b are computed once per triangle and a
@@ -38,11 +49,15 @@
 use glam::{BVec3A, BVec4A, Mat3, Vec3, Vec3A, Vec4};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::node::Bvh2Node;
+use rayon::prelude::*;
 
 use crate::cpu::EDGE_TOLERANCE;
 use crate::refit::LeafOrder;
 use crate::refit::padded_bvh2;
 use crate::scene::Prepared;
+
+#[cfg(target_arch = "x86_64")]
+mod avx2;
 
 /// Rays per fan: one bit each of a `u64` mask.
 pub const FAN_SIZE: usize = 64;
@@ -52,6 +67,9 @@ pub const FAN_GROUP: usize = 4;
 
 /// Groups of four lanes (one SSE `Vec4` each) per fan.
 const GROUPS: usize = FAN_SIZE / FAN_GROUP;
+
+/// Largest subtree (in triangles) that gets a [`Slab`].
+const SLAB_MAX_TRIANGLES: u32 = 1024;
 
 /// Largest triangle count per leaf of the fan BVH.
 const FAN_LEAF_SIZE: u32 = 8;
@@ -289,6 +307,18 @@ pub fn fan_groups(directions: &[Vec3]) -> Vec<Vec<u32>> {
         .collect()
 }
 
+/// Whether this CPU runs AVX2 (the eight-lane fan traversal).
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
 /// Bit 4g set for every group g of four lanes with a lane in `mask`.
 #[inline(always)]
 fn live_groups(mask: u64) -> u64 {
@@ -300,11 +330,60 @@ fn live_groups(mask: u64) -> u64 {
 #[derive(Clone, Copy, Debug)]
 struct FanTriangle([Vec3A; 3]);
 
+/// The region |n·x − c| ≤ h between two parallel planes that holds a leaf's triangles: for
+/// a nearly flat patch much thinner than its box, so the rays that graze a surface (which
+/// cross the boxes of the patches beside their origin) are culled before the triangle
+/// tests.
+#[derive(Clone, Copy, Debug)]
+struct Slab {
+    normal: Vec3A,
+    centre: f32,
+    half: f32,
+}
+
+impl Slab {
+    /// A slab that culls nothing.
+    const UNBOUNDED: Self = Self {
+        normal: Vec3A::ZERO,
+        centre: 0.0,
+        half: f32::INFINITY,
+    };
+
+    /// The slab along the triangles' area-weighted normal, padded by 1e-5 × `diagonal` (the
+    /// scene's coordinates are centred, so rounding in n·x stays far below that).
+    fn around(triangles: impl Iterator<Item = [Vec3A; 3]> + Clone, diagonal: f32) -> Self {
+        let normal = triangles
+            .clone()
+            .map(|[a, b, c]| (b - a).cross(c - a))
+            .sum::<Vec3A>()
+            .normalize_or_zero();
+        if normal == Vec3A::ZERO {
+            return Self::UNBOUNDED;
+        }
+        let (lo, hi) = triangles
+            .flatten()
+            .map(|v| normal.dot(v))
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| {
+                (lo.min(d), hi.max(d))
+            });
+        Self {
+            normal,
+            centre: 0.5 * (lo + hi),
+            half: 0.5 * (hi - lo) + 1e-5 * diagonal,
+        }
+    }
+}
+
 /// The scene's binary BVH for fans, triangles in leaf order.
 pub(crate) struct FanTracer {
     nodes: Vec<Bvh2Node>,
     triangles: Vec<FanTriangle>,
     leaves: LeafOrder,
+    /// Per node, the slab that holds a leaf's triangles (unbounded for inner nodes).
+    slabs: Vec<Slab>,
+    /// Whether the CPU runs AVX2: lanes tested eight at a time instead of four (the same
+    /// answer, bit for bit).
+    wide: bool,
 }
 
 impl FanTracer {
@@ -315,26 +394,80 @@ impl FanTracer {
             .iter()
             .map(|t| FanTriangle([t.v0, t.v1, t.v2]))
             .collect();
-        Self {
+        let mut tracer = Self {
             nodes,
             triangles,
             leaves,
+            slabs: Vec::new(),
+            wide: has_avx2(),
+        };
+        tracer.slabs = tracer.leaf_slabs(prepared.diagonal);
+        tracer
+    }
+
+    /// Each node's [`Slab`] over its triangles, for subtrees of at most
+    /// [`SLAB_MAX_TRIANGLES`] triangles (larger ones: unbounded).
+    fn leaf_slabs(&self, diagonal: f32) -> Vec<Slab> {
+        // Triangles under each node, bottom-up.
+        let mut count = vec![0u32; self.nodes.len()];
+        for &i in &self.leaves.bottom_up {
+            let node = &self.nodes[i as usize];
+            count[i as usize] = if node.prim_count > 0 {
+                node.prim_count
+            } else {
+                let c = node.first_index as usize;
+                count[c] + count[c + 1]
+            };
         }
+        (0..self.nodes.len())
+            .into_par_iter()
+            .map_init(Vec::new, |under: &mut Vec<FanTriangle>, i| {
+                if count[i] > SLAB_MAX_TRIANGLES {
+                    return Slab::UNBOUNDED;
+                }
+                under.clear();
+                let mut stack = vec![i];
+                while let Some(n) = stack.pop() {
+                    let node = &self.nodes[n];
+                    if node.prim_count > 0 {
+                        let first = node.first_index as usize;
+                        under.extend(&self.triangles[first..first + node.prim_count as usize]);
+                    } else {
+                        stack.extend([node.first_index as usize, node.first_index as usize + 1]);
+                    }
+                }
+                Slab::around(under.iter().map(|t| t.0), diagonal)
+            })
+            .collect()
     }
 
     /// Refits to `prepared`'s positions (same topology); the new SAH cost over the build's.
     pub(crate) fn refit(&mut self, prepared: &Prepared) -> Option<f32> {
-        crate::refit::refit_tree(
+        let cost = crate::refit::refit_tree(
             &mut self.nodes,
             &self.leaves,
             &mut self.triangles,
             prepared,
             FanTriangle,
-        )
+        )?;
+        self.slabs = self.leaf_slabs(prepared.diagonal);
+        Some(cost)
     }
 
     /// The lanes of `mask` whose rays `origin + t·d`, 0 < t < `max_t`, meet no triangle.
     pub(crate) fn unoccluded(&self, origin: Vec3A, fan: &RayFan, mask: u64, max_t: f32) -> u64 {
+        #[cfg(target_arch = "x86_64")]
+        if self.wide {
+            // SAFETY: `wide` is set only where `is_x86_feature_detected!("avx2")` said so.
+            #[allow(unsafe_code)]
+            return unsafe {
+                if max_t == f32::INFINITY {
+                    avx2::traverse::<false>(self, origin, fan, mask, max_t)
+                } else {
+                    avx2::traverse::<true>(self, origin, fan, mask, max_t)
+                }
+            };
+        }
         // Two instances: rays to infinity skip the distance comparisons.
         if max_t == f32::INFINITY {
             self.traverse::<false>(origin, fan, mask, max_t)
@@ -358,7 +491,15 @@ impl FanTracer {
         let inv = FanSetup::new(fan, mask);
         let mut visible = mask;
         let mut stack: Vec<(u32, u64)> = Vec::with_capacity(64);
-        let root = box_lanes::<BOUNDED>(&self.nodes[0], origin, &inv, mask, max_t);
+        let root = box_lanes::<BOUNDED>(
+            &self.nodes[0],
+            &self.slabs[0],
+            origin,
+            &inv,
+            fan,
+            mask,
+            max_t,
+        );
         if root != 0 {
             stack.push((0, root));
         }
@@ -396,7 +537,9 @@ impl FanTracer {
                 // Pushed even when empty (the pop skips it): cheaper than a branch that the
                 // predictor misses half the time.
                 for (child, node) in order {
-                    stack.push((child, box_lanes::<BOUNDED>(node, origin, &inv, m, max_t)));
+                    let slab = &self.slabs[child as usize];
+                    let lanes = box_lanes::<BOUNDED>(node, slab, origin, &inv, fan, m, max_t);
+                    stack.push((child, lanes));
                 }
             }
         }
@@ -408,8 +551,10 @@ impl FanTracer {
 #[inline(always)]
 fn box_lanes<const BOUNDED: bool>(
     node: &Bvh2Node,
+    slab: &Slab,
     origin: Vec3A,
     inv: &FanSetup,
+    fan: &RayFan,
     mask: u64,
     max_t: f32,
 ) -> u64 {
@@ -437,6 +582,8 @@ fn box_lanes<const BOUNDED: bool>(
         Vec4::splat(high.z),
     );
     let far = Vec4::splat(max_t);
+    let sliced = slab.half.is_finite();
+    let s0 = Vec4::splat(slab.normal.dot(origin) - slab.centre);
     let mut out = 0u64;
     let mut live = live_groups(mask);
     while live != 0 {
@@ -448,7 +595,19 @@ fn box_lanes<const BOUNDED: bool>(
         let enter = x1.min(x2).max(y1.min(y2)).max(z1.min(z2).max(Vec4::ZERO));
         let leave = x1.max(x2).min(y1.max(y2)).min(z1.max(z2));
         let leave = if BOUNDED { leave.min(far) } else { leave };
-        out |= u64::from(enter.cmple(leave).bitmask()) << (4 * g);
+        let mut inside = enter.cmple(leave);
+        if sliced {
+            // The signed distance to the slab's mid-plane where the ray enters and leaves
+            // the box: a lane is out when both ends lie beyond the same face.
+            let n = slab.normal;
+            let along = fan.x[g] * n.x + fan.y[g] * n.y + fan.z[g] * n.z;
+            let (a, b) = (s0 + enter * along, s0 + leave * along);
+            let half = Vec4::splat(slab.half);
+            let above = a.cmpgt(half) & b.cmpgt(half);
+            let below = a.cmplt(-half) & b.cmplt(-half);
+            inside &= !(above | below);
+        }
+        out |= u64::from(inside.bitmask()) << (4 * g);
     }
     out & mask
 }
@@ -495,4 +654,84 @@ fn triangle_lanes<const BOUNDED: bool>(
         out |= u64::from(hit.bitmask()) << (4 * g);
     }
     out & mask
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use glam::{Vec3, Vec3A};
+    use obvhs::BvhBuildParams;
+
+    use super::{FanTracer, RayFan, fan_groups};
+    use crate::scene::{Prepared, Scene};
+
+    /// A crumpled sheet: a 40 × 40 grid with pseudo-random heights, so rays from it graze,
+    /// hit and escape in every proportion.
+    fn crumpled() -> Scene {
+        let n = 40u32;
+        let mut state = 0x2545_f491_u32;
+        let mut noise = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as f32 / u32::MAX as f32
+        };
+        let positions: Vec<Vec3> = (0..n * n)
+            .map(|i| {
+                let (x, z) = ((i % n) as f32, (i / n) as f32);
+                Vec3::new(x, 6.0 * noise() + (x * 0.3).sin() * 4.0, z)
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for z in 0..n - 1 {
+            for x in 0..n - 1 {
+                let i = z * n + x;
+                triangles.push([i, i + 1, i + n]);
+                triangles.push([i + 1, i + n + 1, i + n]);
+            }
+        }
+        let normals = vec![Vec3::Y; positions.len()];
+        Scene::single(positions, normals, triangles).unwrap()
+    }
+
+    /// The AVX2 traversal answers every lane exactly as the four-lane one: same bits for
+    /// every vertex of a crumpled sheet, every fan of the level-3 lightsphere, to infinity
+    /// and within a finite distance.
+    #[test]
+    fn eight_lanes_answer_as_four_lanes() {
+        if !std::is_x86_feature_detected!("avx2") {
+            eprintln!("skipping: this CPU has no AVX2");
+            return;
+        }
+        let prepared = Prepared::new(&crumpled()).unwrap();
+        let tracer = FanTracer::new(&prepared, BvhBuildParams::medium_build());
+        let sphere = lightsphere::Lightsphere::new(3).unwrap();
+        let directions: Vec<Vec3> = sphere.directions().to_vec();
+        let fans: Vec<RayFan> = fan_groups(&directions)
+            .iter()
+            .map(|g| RayFan::from_group(&directions, g))
+            .collect();
+        let (mut lanes, mut open, mut differ) = (0u32, 0u32, 0u32);
+        for receiver in &prepared.receivers {
+            let origin = Vec3A::from(receiver.position) + Vec3A::Y * 1e-3;
+            for fan in &fans {
+                let mask = fan.full_mask();
+                for max_t in [f32::INFINITY, 5.0] {
+                    let four = if max_t == f32::INFINITY {
+                        tracer.traverse::<false>(origin, fan, mask, max_t)
+                    } else {
+                        tracer.traverse::<true>(origin, fan, mask, max_t)
+                    };
+                    let eight = tracer.unoccluded(origin, fan, mask, max_t);
+                    lanes += mask.count_ones();
+                    open += four.count_ones();
+                    differ += (four ^ eight).count_ones();
+                }
+            }
+        }
+        assert_eq!(differ, 0, "{differ} of {lanes} lanes differ");
+        assert!(
+            open > lanes / 10 && open < lanes * 9 / 10,
+            "{open} of {lanes} open"
+        );
+    }
 }
