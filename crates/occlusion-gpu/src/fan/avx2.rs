@@ -145,12 +145,14 @@ fn box_lanes<const BOUNDED: bool>(
         return mask;
     }
     let inv = fan.setup;
-    let (pa, pc) = (low * inv.bound_lo, low * inv.bound_hi);
-    let (qa, qc) = (high * inv.bound_lo, high * inv.bound_hi);
-    let enter = Vec3A::select(inv.bounded, pa.min(pc).min(qa.min(qc)), Vec3A::NEG_INFINITY);
-    let leave = Vec3A::select(inv.bounded, pa.max(pc).max(qa.max(qc)), Vec3A::INFINITY);
-    if enter.max_element().max(0.0) > leave.min_element().min(max_t) {
-        return 0;
+    if inv.interval {
+        let (pa, pc) = (low * inv.bound_lo, low * inv.bound_hi);
+        let (qa, qc) = (high * inv.bound_lo, high * inv.bound_hi);
+        let enter = Vec3A::select(inv.bounded, pa.min(pc).min(qa.min(qc)), Vec3A::NEG_INFINITY);
+        let leave = Vec3A::select(inv.bounded, pa.max(pc).max(qa.max(qc)), Vec3A::INFINITY);
+        if enter.max_element().max(0.0) > leave.min_element().min(max_t) {
+            return 0;
+        }
     }
     let (lx, ly, lz) = (
         _mm256_set1_ps(low.x),
