@@ -53,7 +53,7 @@ use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::ray::Ray;
 use rayon::prelude::*;
 
-use crate::fan::{FanTracer, RayFan, fan_groups};
+use crate::fan::{FanTracer, PreparedDirections, RayFan, fan_groups};
 use crate::matrix::WORD_BITS;
 use crate::progress::Ticker;
 use crate::refit::{LeafOrder, padded_bvh2, scene_triangles};
@@ -685,36 +685,48 @@ fn fan_columns(
         .filter(|&i| i != u32::MAX)
         .collect();
     let curve_dirs: Vec<Vec3> = curve.iter().map(|&i| dirs[i as usize]).collect();
+    let prepared_dirs = PreparedDirections::new(&curve_dirs);
     let order = morton_order(prepared);
     let chunks: Vec<(Vec<u32>, u64)> = order
         .par_chunks(ROWS_PER_CHUNK)
         .map(|rows| {
             let mut out = vec![0u32; rows.len() * words_per_row];
             let mut rays = 0u64;
-            let mut facing: Vec<u32> = Vec::with_capacity(curve.len());
+            let mut facing = Vec::new();
             let mut fan = RayFan::new();
             for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
                 let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
                     continue;
                 };
-                let normal = Vec3::from(normal);
-                facing.clear();
-                facing.extend(
-                    (0..curve.len() as u32).filter(|&c| normal.dot(curve_dirs[c as usize]) > 0.0),
-                );
-                rays += facing.len() as u64;
-                let count = facing.len().div_ceil(crate::fan::FAN_SIZE);
+                prepared_dirs.facing(normal.into(), &mut facing);
+                let n = facing
+                    .iter()
+                    .map(|w| w.count_ones() as usize)
+                    .sum::<usize>();
+                rays += n as u64;
+                let count = n.div_ceil(crate::fan::FAN_SIZE);
+                // The facing directions in curve order, cut into `count` equal runs.
+                let mut lanes = [0u32; crate::fan::FAN_SIZE];
+                let (mut word, mut bits) = (0usize, facing.first().copied().unwrap_or(0));
+                let mut taken = 0usize;
                 for f in 0..count {
-                    let run = &facing[f * facing.len() / count..(f + 1) * facing.len() / count];
+                    let end = (f + 1) * n / count;
                     fan.clear();
-                    for &c in run {
-                        fan.push(curve_dirs[c as usize]);
+                    while taken < end {
+                        while bits == 0 {
+                            word += 1;
+                            bits = facing[word];
+                        }
+                        let c = word * 64 + bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        lanes[fan.push_prepared(&prepared_dirs, c)] = curve[c];
+                        taken += 1;
                     }
                     let mut open = tracer.unoccluded(origin, &fan, fan.full_mask(), span.max_t);
                     while open != 0 {
                         let lane = open.trailing_zeros() as usize;
                         open &= open - 1;
-                        let j = columns.start + curve[run[lane] as usize] as usize;
+                        let j = columns.start + lanes[lane] as usize;
                         out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
                     }
                 }

@@ -89,6 +89,11 @@ pub struct RayFan {
     x: [Vec4; GROUPS],
     y: [Vec4; GROUPS],
     z: [Vec4; GROUPS],
+    /// The reciprocal of each component ([`reciprocal`]), kept with the direction: the slab
+    /// test's, computed once per push instead of once per traversal.
+    ix: [Vec4; GROUPS],
+    iy: [Vec4; GROUPS],
+    iz: [Vec4; GROUPS],
     len: usize,
     used: u64,
 }
@@ -99,8 +104,75 @@ impl Default for RayFan {
             x: [Vec4::ZERO; GROUPS],
             y: [Vec4::ZERO; GROUPS],
             z: [Vec4::ZERO; GROUPS],
+            ix: [Vec4::ZERO; GROUPS],
+            iy: [Vec4::ZERO; GROUPS],
+            iz: [Vec4::ZERO; GROUPS],
             len: 0,
             used: 0,
+        }
+    }
+}
+
+/// One coordinate of every lane, as a flat array.
+#[inline(always)]
+fn lanes_of(groups: &mut [Vec4; GROUPS]) -> &mut [f32; FAN_SIZE] {
+    bytemuck::cast_mut(groups)
+}
+
+/// The slab test's reciprocal of each component, a zero becoming a huge finite value of its
+/// sign (so a slab product is never 0 · ∞).
+#[inline(always)]
+fn reciprocal(v: Vec4) -> Vec4 {
+    Vec4::select(
+        v.abs().cmplt(Vec4::splat(1e-30)),
+        Vec4::splat(1e30).copysign(v),
+        v.recip(),
+    )
+}
+
+/// Directions with their [`reciprocal`]s, ready to be pushed into fans many times
+/// ([`RayFan::push_prepared`]): the lightsphere's, shared by every vertex.
+pub(crate) struct PreparedDirections {
+    /// Directions, four per vector (the last vector padded with zeros).
+    pub(crate) xyz: [Vec<Vec4>; 3],
+    /// Their reciprocals, likewise.
+    pub(crate) inv: [Vec<Vec4>; 3],
+    /// Number of directions.
+    pub(crate) len: usize,
+}
+
+impl PreparedDirections {
+    pub(crate) fn new(directions: &[Vec3]) -> Self {
+        let quads = directions.len().div_ceil(4);
+        let xyz = [0, 1, 2].map(|k| {
+            let mut coordinate = vec![Vec4::ZERO; quads];
+            let flat: &mut [f32] = bytemuck::cast_slice_mut(&mut coordinate);
+            for (f, d) in flat.iter_mut().zip(directions) {
+                *f = d[k];
+            }
+            coordinate
+        });
+        let inv = [0, 1, 2].map(|k| xyz[k].iter().map(|&v| reciprocal(v)).collect());
+        Self {
+            xyz,
+            inv,
+            len: directions.len(),
+        }
+    }
+
+    /// Bit i of word i / 64: direction i has d·`normal` > 0 (the same sum, in the same order,
+    /// as `Vec3::dot`).
+    pub(crate) fn facing(&self, normal: Vec3, words: &mut Vec<u64>) {
+        words.clear();
+        words.resize(self.len.div_ceil(64), 0);
+        for (q, ((x, y), z)) in self.xyz[0]
+            .iter()
+            .zip(&self.xyz[1])
+            .zip(&self.xyz[2])
+            .enumerate()
+        {
+            let dot = *x * normal.x + *y * normal.y + *z * normal.z;
+            words[q / 16] |= u64::from(dot.cmpgt(Vec4::ZERO).bitmask()) << (4 * (q % 16));
         }
     }
 }
@@ -124,14 +196,38 @@ impl RayFan {
     pub fn push(&mut self, direction: Vec3) -> usize {
         assert!(self.len < FAN_SIZE, "a fan holds at most {FAN_SIZE} rays");
         let lane = self.len;
-        let (g, i) = (lane / 4, lane % 4);
-        self.x[g][i] = direction.x;
-        self.y[g][i] = direction.y;
-        self.z[g][i] = direction.z;
+        let inv = reciprocal(direction.extend(0.0));
+        lanes_of(&mut self.x)[lane] = direction.x;
+        lanes_of(&mut self.y)[lane] = direction.y;
+        lanes_of(&mut self.z)[lane] = direction.z;
+        lanes_of(&mut self.ix)[lane] = inv.x;
+        lanes_of(&mut self.iy)[lane] = inv.y;
+        lanes_of(&mut self.iz)[lane] = inv.z;
         self.len += 1;
         if direction.is_finite() && direction != Vec3::ZERO {
             self.used |= 1 << lane;
         }
+        lane
+    }
+
+    /// Appends direction `index` of `directions` (finite and non-zero, as a lightsphere's
+    /// are) with its reciprocal; returns its lane.
+    #[inline]
+    pub(crate) fn push_prepared(&mut self, directions: &PreparedDirections, index: usize) -> usize {
+        assert!(self.len < FAN_SIZE, "a fan holds at most {FAN_SIZE} rays");
+        let lane = self.len;
+        // Flat views: a `Vec4` index is a `match` on the lane, a branch the predictor misses.
+        let source = |v: &Vec<Vec4>| bytemuck::cast_slice::<Vec4, f32>(v)[index];
+        let [x, y, z] = &directions.xyz;
+        let [ix, iy, iz] = &directions.inv;
+        lanes_of(&mut self.x)[lane] = source(x);
+        lanes_of(&mut self.y)[lane] = source(y);
+        lanes_of(&mut self.z)[lane] = source(z);
+        lanes_of(&mut self.ix)[lane] = source(ix);
+        lanes_of(&mut self.iy)[lane] = source(iy);
+        lanes_of(&mut self.iz)[lane] = source(iz);
+        self.len += 1;
+        self.used |= 1 << lane;
         lane
     }
 
@@ -167,6 +263,9 @@ impl RayFan {
             out.x[g] = x * c0.x + y * c1.x + z * c2.x;
             out.y[g] = x * c0.y + y * c1.y + z * c2.y;
             out.z[g] = x * c0.z + y * c1.z + z * c2.z;
+            out.ix[g] = reciprocal(out.x[g]);
+            out.iy[g] = reciprocal(out.y[g]);
+            out.iz[g] = reciprocal(out.z[g]);
         }
         out.len = self.len;
         out.used = self.used;
@@ -196,17 +295,15 @@ impl RayFan {
 
     /// The direction of `lane`.
     pub fn direction(&self, lane: usize) -> Vec3 {
-        let (g, i) = (lane / 4, lane % 4);
-        Vec3::new(self.x[g][i], self.y[g][i], self.z[g][i])
+        let flat =
+            |v: &[Vec4; GROUPS]| bytemuck::cast_ref::<[Vec4; GROUPS], [f32; FAN_SIZE]>(v)[lane];
+        Vec3::new(flat(&self.x), flat(&self.y), flat(&self.z))
     }
 }
 
-/// A fan's reciprocal directions and the interval each axis spans over the live lanes
+/// The interval each axis of a fan's reciprocal directions spans over the live lanes
 /// (`bounded` false where the lanes' signs differ: that axis does not bound the fan).
 struct FanSetup {
-    x: [Vec4; GROUPS],
-    y: [Vec4; GROUPS],
-    z: [Vec4; GROUPS],
     bound_lo: Vec3A,
     bound_hi: Vec3A,
     bounded: BVec3A,
@@ -217,24 +314,6 @@ struct FanSetup {
 
 impl FanSetup {
     fn new(fan: &RayFan, mask: u64) -> Self {
-        // The reciprocal of each component, a zero becoming a huge finite value of its sign
-        // (so a slab product is never 0 · ∞).
-        let recip = |v: Vec4| {
-            Vec4::select(
-                v.abs().cmplt(Vec4::splat(1e-30)),
-                Vec4::splat(1e30).copysign(v),
-                v.recip(),
-            )
-        };
-        let mut r = Self {
-            x: fan.x.map(recip),
-            y: fan.y.map(recip),
-            z: fan.z.map(recip),
-            bound_lo: Vec3A::ZERO,
-            bound_hi: Vec3A::ZERO,
-            bounded: BVec3A::FALSE,
-            interval: false,
-        };
         let (mut low, mut high) = ([Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]);
         let mut live = live_groups(mask);
         while live != 0 {
@@ -247,11 +326,17 @@ impl FanSetup {
                 nibble & 4 != 0,
                 nibble & 8 != 0,
             );
-            for (k, inv) in [r.x[g], r.y[g], r.z[g]].into_iter().enumerate() {
+            for (k, inv) in [fan.ix[g], fan.iy[g], fan.iz[g]].into_iter().enumerate() {
                 low[k] = low[k].min(Vec4::select(on, inv, Vec4::INFINITY));
                 high[k] = high[k].max(Vec4::select(on, inv, Vec4::NEG_INFINITY));
             }
         }
+        let mut r = Self {
+            bound_lo: Vec3A::ZERO,
+            bound_hi: Vec3A::ZERO,
+            bounded: BVec3A::FALSE,
+            interval: false,
+        };
         let mut bounded = [false; 3];
         for k in 0..3 {
             let (a, b) = (low[k].min_element(), high[k].max_element());
@@ -604,9 +689,9 @@ fn box_lanes<const BOUNDED: bool>(
     while live != 0 {
         let g = live.trailing_zeros() as usize / 4;
         live &= live - 1;
-        let (x1, x2) = (lx * inv.x[g], hx * inv.x[g]);
-        let (y1, y2) = (ly * inv.y[g], hy * inv.y[g]);
-        let (z1, z2) = (lz * inv.z[g], hz * inv.z[g]);
+        let (x1, x2) = (lx * fan.ix[g], hx * fan.ix[g]);
+        let (y1, y2) = (ly * fan.iy[g], hy * fan.iy[g]);
+        let (z1, z2) = (lz * fan.iz[g], hz * fan.iz[g]);
         let enter = x1.min(x2).max(y1.min(y2)).max(z1.min(z2).max(Vec4::ZERO));
         let leave = x1.max(x2).min(y1.max(y2)).min(z1.max(z2));
         let leave = if BOUNDED { leave.min(far) } else { leave };

@@ -66,9 +66,9 @@ pub(super) fn traverse<const BOUNDED: bool>(
         x: widen(&fan.x),
         y: widen(&fan.y),
         z: widen(&fan.z),
-        ix: widen(&setup.x),
-        iy: widen(&setup.y),
-        iz: widen(&setup.z),
+        ix: widen(&fan.ix),
+        iy: widen(&fan.iy),
+        iz: widen(&fan.iz),
         setup: &setup,
     };
     let mut visible = mask;
