@@ -52,7 +52,6 @@
 use glam::{BVec3A, BVec4A, Mat3, Vec3, Vec3A, Vec4};
 use obvhs::BvhBuildParams;
 use obvhs::bvh2::node::Bvh2Node;
-use rayon::prelude::*;
 
 use crate::cpu::EDGE_TOLERANCE;
 use crate::refit::LeafOrder;
@@ -61,6 +60,9 @@ use crate::scene::Prepared;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod slab;
+
+use slab::{Slab, subtree_slabs};
 
 /// Rays per fan: one bit each of a `u64` mask.
 pub const FAN_SIZE: usize = 64;
@@ -75,9 +77,6 @@ const GROUPS: usize = FAN_SIZE / FAN_GROUP;
 /// run: with fewer it culls next to nothing and costs 8–9 % (the bunny's per-vertex fans at
 /// k = 258); a hemicube's narrow fans bound all three, and lose 4 % without it at HC 32².
 const INTERVAL_AXES: usize = 2;
-
-/// Largest subtree (in triangles) that gets a [`Slab`].
-const SLAB_MAX_TRIANGLES: u32 = 1024;
 
 /// Largest triangle count per leaf of the fan BVH.
 const FAN_LEAF_SIZE: u32 = 8;
@@ -428,56 +427,12 @@ fn live_groups(mask: u64) -> u64 {
 #[derive(Clone, Copy, Debug)]
 struct FanTriangle([Vec3A; 3]);
 
-/// The region |n·x − c| ≤ h between two parallel planes that holds a leaf's triangles: for
-/// a nearly flat patch much thinner than its box, so the rays that graze a surface (which
-/// cross the boxes of the patches beside their origin) are culled before the triangle
-/// tests.
-#[derive(Clone, Copy, Debug)]
-struct Slab {
-    normal: Vec3A,
-    centre: f32,
-    half: f32,
-}
-
-impl Slab {
-    /// A slab that culls nothing.
-    const UNBOUNDED: Self = Self {
-        normal: Vec3A::ZERO,
-        centre: 0.0,
-        half: f32::INFINITY,
-    };
-
-    /// The slab along the triangles' area-weighted normal, padded by 1e-5 × `diagonal` (the
-    /// scene's coordinates are centred, so rounding in n·x stays far below that).
-    fn around(triangles: impl Iterator<Item = [Vec3A; 3]> + Clone, diagonal: f32) -> Self {
-        let normal = triangles
-            .clone()
-            .map(|[a, b, c]| (b - a).cross(c - a))
-            .sum::<Vec3A>()
-            .normalize_or_zero();
-        if normal == Vec3A::ZERO {
-            return Self::UNBOUNDED;
-        }
-        let (lo, hi) = triangles
-            .flatten()
-            .map(|v| normal.dot(v))
-            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), d| {
-                (lo.min(d), hi.max(d))
-            });
-        Self {
-            normal,
-            centre: 0.5 * (lo + hi),
-            half: 0.5 * (hi - lo) + 1e-5 * diagonal,
-        }
-    }
-}
-
 /// The scene's binary BVH for fans, triangles in leaf order.
 pub(crate) struct FanTracer {
     nodes: Vec<Bvh2Node>,
     triangles: Vec<FanTriangle>,
     leaves: LeafOrder,
-    /// Per node, the slab that holds a leaf's triangles (unbounded for inner nodes).
+    /// Per node, the [`Slab`] of its subtree's triangles (unbounded for large subtrees).
     slabs: Vec<Slab>,
     /// Whether the CPU runs AVX2: lanes tested eight at a time instead of four (the same
     /// answer, bit for bit).
@@ -499,44 +454,13 @@ impl FanTracer {
             slabs: Vec::new(),
             wide: has_avx2(),
         };
-        tracer.slabs = tracer.leaf_slabs(prepared.diagonal);
+        tracer.slabs = subtree_slabs(
+            &tracer.nodes,
+            &tracer.leaves,
+            &tracer.triangles,
+            prepared.diagonal,
+        );
         tracer
-    }
-
-    /// Each node's [`Slab`] over its triangles, for subtrees of at most
-    /// [`SLAB_MAX_TRIANGLES`] triangles (larger ones: unbounded).
-    fn leaf_slabs(&self, diagonal: f32) -> Vec<Slab> {
-        // Triangles under each node, bottom-up.
-        let mut count = vec![0u32; self.nodes.len()];
-        for &i in &self.leaves.bottom_up {
-            let node = &self.nodes[i as usize];
-            count[i as usize] = if node.prim_count > 0 {
-                node.prim_count
-            } else {
-                let c = node.first_index as usize;
-                count[c] + count[c + 1]
-            };
-        }
-        (0..self.nodes.len())
-            .into_par_iter()
-            .map_init(Vec::new, |under: &mut Vec<FanTriangle>, i| {
-                if count[i] > SLAB_MAX_TRIANGLES {
-                    return Slab::UNBOUNDED;
-                }
-                under.clear();
-                let mut stack = vec![i];
-                while let Some(n) = stack.pop() {
-                    let node = &self.nodes[n];
-                    if node.prim_count > 0 {
-                        let first = node.first_index as usize;
-                        under.extend(&self.triangles[first..first + node.prim_count as usize]);
-                    } else {
-                        stack.extend([node.first_index as usize, node.first_index as usize + 1]);
-                    }
-                }
-                Slab::around(under.iter().map(|t| t.0), diagonal)
-            })
-            .collect()
     }
 
     /// Refits to `prepared`'s positions (same topology); the new SAH cost over the build's.
@@ -548,7 +472,12 @@ impl FanTracer {
             prepared,
             FanTriangle,
         )?;
-        self.slabs = self.leaf_slabs(prepared.diagonal);
+        self.slabs = subtree_slabs(
+            &self.nodes,
+            &self.leaves,
+            &self.triangles,
+            prepared.diagonal,
+        );
         Some(cost)
     }
 
@@ -757,81 +686,4 @@ fn triangle_lanes<const BOUNDED: bool>(
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]
-mod tests {
-    use glam::{Vec3, Vec3A};
-    use obvhs::BvhBuildParams;
-
-    use super::{FanTracer, RayFan, fan_groups};
-    use crate::scene::{Prepared, Scene};
-
-    /// A crumpled sheet: a 40 × 40 grid with pseudo-random heights, so rays from it graze,
-    /// hit and escape in every proportion.
-    fn crumpled() -> Scene {
-        let n = 40u32;
-        let mut state = 0x2545_f491_u32;
-        let mut noise = || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / u32::MAX as f32
-        };
-        let positions: Vec<Vec3> = (0..n * n)
-            .map(|i| {
-                let (x, z) = ((i % n) as f32, (i / n) as f32);
-                Vec3::new(x, 6.0 * noise() + (x * 0.3).sin() * 4.0, z)
-            })
-            .collect();
-        let mut triangles = Vec::new();
-        for z in 0..n - 1 {
-            for x in 0..n - 1 {
-                let i = z * n + x;
-                triangles.push([i, i + 1, i + n]);
-                triangles.push([i + 1, i + n + 1, i + n]);
-            }
-        }
-        let normals = vec![Vec3::Y; positions.len()];
-        Scene::single(positions, normals, triangles).unwrap()
-    }
-
-    /// The AVX2 traversal answers every lane exactly as the four-lane one: same bits for
-    /// every vertex of a crumpled sheet, every fan of the level-3 lightsphere, to infinity
-    /// and within a finite distance.
-    #[test]
-    fn eight_lanes_answer_as_four_lanes() {
-        if !std::is_x86_feature_detected!("avx2") {
-            eprintln!("skipping: this CPU has no AVX2");
-            return;
-        }
-        let prepared = Prepared::new(&crumpled()).unwrap();
-        let tracer = FanTracer::new(&prepared, BvhBuildParams::medium_build());
-        let sphere = lightsphere::Lightsphere::new(3).unwrap();
-        let directions: Vec<Vec3> = sphere.directions().to_vec();
-        let fans: Vec<RayFan> = fan_groups(&directions)
-            .iter()
-            .map(|g| RayFan::from_group(&directions, g))
-            .collect();
-        let (mut lanes, mut open, mut differ) = (0u32, 0u32, 0u32);
-        for receiver in &prepared.receivers {
-            let origin = Vec3A::from(receiver.position) + Vec3A::Y * 1e-3;
-            for fan in &fans {
-                let mask = fan.full_mask();
-                for max_t in [f32::INFINITY, 5.0] {
-                    let four = if max_t == f32::INFINITY {
-                        tracer.traverse::<false>(origin, fan, mask, max_t)
-                    } else {
-                        tracer.traverse::<true>(origin, fan, mask, max_t)
-                    };
-                    let eight = tracer.unoccluded(origin, fan, mask, max_t);
-                    lanes += mask.count_ones();
-                    open += four.count_ones();
-                    differ += (four ^ eight).count_ones();
-                }
-            }
-        }
-        assert_eq!(differ, 0, "{differ} of {lanes} lanes differ");
-        assert!(
-            open > lanes / 10 && open < lanes * 9 / 10,
-            "{open} of {lanes} open"
-        );
-    }
-}
+mod tests;

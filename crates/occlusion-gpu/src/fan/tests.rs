@@ -1,0 +1,78 @@
+//! The eight-lane (AVX2) traversal against the four-lane one.
+
+use glam::{Vec3, Vec3A};
+use obvhs::BvhBuildParams;
+
+use super::{FanTracer, RayFan, fan_groups};
+use crate::scene::{Prepared, Scene};
+
+/// A crumpled sheet: a 40 × 40 grid with pseudo-random heights, so rays from it graze,
+/// hit and escape in every proportion.
+fn crumpled() -> Scene {
+    let n = 40u32;
+    let mut state = 0x2545_f491_u32;
+    let mut noise = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as f32 / u32::MAX as f32
+    };
+    let positions: Vec<Vec3> = (0..n * n)
+        .map(|i| {
+            let (x, z) = ((i % n) as f32, (i / n) as f32);
+            Vec3::new(x, 6.0 * noise() + (x * 0.3).sin() * 4.0, z)
+        })
+        .collect();
+    let mut triangles = Vec::new();
+    for z in 0..n - 1 {
+        for x in 0..n - 1 {
+            let i = z * n + x;
+            triangles.push([i, i + 1, i + n]);
+            triangles.push([i + 1, i + n + 1, i + n]);
+        }
+    }
+    let normals = vec![Vec3::Y; positions.len()];
+    Scene::single(positions, normals, triangles).unwrap()
+}
+
+/// The AVX2 traversal answers every lane exactly as the four-lane one: same bits for
+/// every vertex of a crumpled sheet, every fan of the level-3 lightsphere, to infinity
+/// and within a finite distance.
+#[test]
+fn eight_lanes_answer_as_four_lanes() {
+    if !std::is_x86_feature_detected!("avx2") {
+        eprintln!("skipping: this CPU has no AVX2");
+        return;
+    }
+    let prepared = Prepared::new(&crumpled()).unwrap();
+    let tracer = FanTracer::new(&prepared, BvhBuildParams::medium_build());
+    let sphere = lightsphere::Lightsphere::new(3).unwrap();
+    let directions: Vec<Vec3> = sphere.directions().to_vec();
+    let fans: Vec<RayFan> = fan_groups(&directions)
+        .iter()
+        .map(|g| RayFan::from_group(&directions, g))
+        .collect();
+    let (mut lanes, mut open, mut differ) = (0u32, 0u32, 0u32);
+    for receiver in &prepared.receivers {
+        let origin = Vec3A::from(receiver.position) + Vec3A::Y * 1e-3;
+        for fan in &fans {
+            let mask = fan.full_mask();
+            for max_t in [f32::INFINITY, 5.0] {
+                let four = if max_t == f32::INFINITY {
+                    tracer.traverse::<false>(origin, fan, mask, max_t)
+                } else {
+                    tracer.traverse::<true>(origin, fan, mask, max_t)
+                };
+                let eight = tracer.unoccluded(origin, fan, mask, max_t);
+                lanes += mask.count_ones();
+                open += four.count_ones();
+                differ += (four ^ eight).count_ones();
+            }
+        }
+    }
+    assert_eq!(differ, 0, "{differ} of {lanes} lanes differ");
+    assert!(
+        open > lanes / 10 && open < lanes * 9 / 10,
+        "{open} of {lanes} open"
+    );
+}
