@@ -13,9 +13,8 @@ use std::arch::x86_64::{
 };
 
 use glam::{Vec3A, Vec4};
-use obvhs::bvh2::node::Bvh2Node;
 
-use super::{FanSetup, FanTracer, FanTriangle, GROUPS, RayFan, Slab};
+use super::{FanNode, FanSetup, FanTracer, FanTriangle, GROUPS, RayFan, single_lane};
 use crate::cpu::EDGE_TOLERANCE;
 
 /// Lanes per AVX2 group.
@@ -73,23 +72,27 @@ pub(super) fn traverse<const BOUNDED: bool>(
     };
     let mut visible = mask;
     let mut stack: Vec<(u32, u64)> = Vec::with_capacity(64);
-    let root = box_lanes::<BOUNDED>(
-        &tracer.nodes[0],
-        &tracer.slabs[0],
-        origin,
-        &wide,
-        mask,
-        max_t,
-    );
+    let mut single = Vec::with_capacity(64);
+    let root = box_lanes::<BOUNDED>(tracer.node(tracer.root), origin, &wide, mask, max_t);
     if root != 0 {
-        stack.push((0, root));
+        stack.push((tracer.root, root));
     }
     while let Some((index, m)) = stack.pop() {
         let mut m = m & visible;
         if m == 0 {
             continue;
         }
-        let node = &tracer.nodes[index as usize];
+        if tracer.single && m.is_power_of_two() {
+            let ray = fan.lane_ray(m.trailing_zeros() as usize);
+            if single_lane::<BOUNDED>(tracer, index, origin, ray, max_t, &mut single) {
+                visible &= !m;
+                if visible == 0 {
+                    return 0;
+                }
+            }
+            continue;
+        }
+        let node = tracer.node(index);
         if node.prim_count > 0 {
             let first = node.first_index as usize;
             for t in &tracer.triangles[first..first + node.prim_count as usize] {
@@ -105,22 +108,15 @@ pub(super) fn traverse<const BOUNDED: bool>(
             }
         } else {
             let first = node.first_index;
-            let (a, b) = (
-                &tracer.nodes[first as usize],
-                &tracer.nodes[first as usize + 1],
-            );
-            let distance = |n: &Bvh2Node| (n.aabb.min + n.aabb.max - 2.0 * origin).length_squared();
+            let (a, b) = (tracer.node(first), tracer.node(first + 1));
+            let distance = |n: &FanNode| (n.min + n.max - 2.0 * origin).length_squared();
             let order = if distance(a) <= distance(b) {
                 [(first + 1, b), (first, a)]
             } else {
                 [(first, a), (first + 1, b)]
             };
             for (child, node) in order {
-                let slab = &tracer.slabs[child as usize];
-                stack.push((
-                    child,
-                    box_lanes::<BOUNDED>(node, slab, origin, &wide, m, max_t),
-                ));
+                stack.push((child, box_lanes::<BOUNDED>(node, origin, &wide, m, max_t)));
             }
         }
     }
@@ -132,15 +128,14 @@ pub(super) fn traverse<const BOUNDED: bool>(
 #[target_feature(enable = "avx2")]
 #[inline]
 fn box_lanes<const BOUNDED: bool>(
-    node: &Bvh2Node,
-    slab: &Slab,
+    node: &FanNode,
     origin: Vec3A,
     fan: &WideFan<'_>,
     mask: u64,
     max_t: f32,
 ) -> u64 {
-    let low = node.aabb.min - origin;
-    let high = node.aabb.max - origin;
+    let low = node.min - origin;
+    let high = node.max - origin;
     if low.cmple(Vec3A::ZERO).all() && high.cmpge(Vec3A::ZERO).all() {
         return mask;
     }
@@ -166,14 +161,14 @@ fn box_lanes<const BOUNDED: bool>(
     );
     let far = _mm256_set1_ps(max_t);
     let zero = _mm256_setzero_ps();
-    let sliced = slab.half.is_finite();
+    let sliced = node.half.is_finite();
     let (nx, ny, nz) = (
-        _mm256_set1_ps(slab.normal.x),
-        _mm256_set1_ps(slab.normal.y),
-        _mm256_set1_ps(slab.normal.z),
+        _mm256_set1_ps(node.normal.x),
+        _mm256_set1_ps(node.normal.y),
+        _mm256_set1_ps(node.normal.z),
     );
-    let s0 = _mm256_set1_ps(slab.normal.dot(origin) - slab.centre);
-    let (half, minus_half) = (_mm256_set1_ps(slab.half), _mm256_set1_ps(-slab.half));
+    let s0 = _mm256_set1_ps(node.normal.dot(origin) - node.centre);
+    let (half, minus_half) = (_mm256_set1_ps(node.half), _mm256_set1_ps(-node.half));
     let mut out = 0u64;
     let mut live = live_wide(mask);
     while live != 0 {

@@ -76,3 +76,46 @@ fn eight_lanes_answer_as_four_lanes() {
         "{open} of {lanes} open"
     );
 }
+
+/// A fan's last live lane, traced alone through the rest of a subtree ([`super::single_lane`]),
+/// answers as the lane groups do: same bits for every vertex of the crumpled sheet (from the
+/// vertex itself, where the grid's integer coordinates put origins on box faces and the
+/// lightsphere's axis directions make 0·∞, and from just above it), every fan of the level-3
+/// lightsphere, to infinity and within a finite distance.
+#[test]
+fn single_lane_answers_as_lane_groups() {
+    let prepared = Prepared::new(&crumpled()).unwrap();
+    let mut tracer = FanTracer::new(&prepared, BvhBuildParams::medium_build());
+    let sphere = lightsphere::Lightsphere::new(3).unwrap();
+    let directions: Vec<Vec3> = sphere.directions().to_vec();
+    let fans: Vec<RayFan> = fan_groups(&directions)
+        .iter()
+        .map(|g| RayFan::from_group(&directions, g))
+        .collect();
+    let trace = |tracer: &FanTracer| {
+        let mut out = Vec::new();
+        for receiver in &prepared.receivers {
+            for lift in [0.0, 1e-3] {
+                let origin = Vec3A::from(receiver.position) + Vec3A::Y * lift;
+                for fan in &fans {
+                    for max_t in [f32::INFINITY, 5.0] {
+                        out.push(tracer.unoccluded(origin, fan, fan.full_mask(), max_t));
+                    }
+                }
+            }
+        }
+        out
+    };
+    assert!(tracer.single);
+    let alone = trace(&tracer);
+    tracer.single = false;
+    let groups = trace(&tracer);
+    let lanes: u32 = groups.iter().map(|m| m.count_ones()).sum();
+    let differ: u32 = alone
+        .iter()
+        .zip(&groups)
+        .map(|(a, b)| (a ^ b).count_ones())
+        .sum();
+    assert_eq!(differ, 0, "{differ} lanes differ");
+    assert!(lanes > 0);
+}
