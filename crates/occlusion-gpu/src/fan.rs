@@ -24,11 +24,14 @@
 //!   box, and the rays that graze the surface near their origin cross the boxes of the
 //!   patches beside it: on the bunny at k = 258 leaf slabs alone took 5 % off, slabs up to
 //!   128 / 512 / 1,024 / 4,096 triangles 12 / 16 / 17 / 17 %;
-//! * a subtree that only one live lane enters is walked by that ray alone ([`single_lane`]):
-//!   lanes diverge with depth, and on the bunny at k = 258 44 % of the internal nodes
-//!   visited held one live lane (55 % two or fewer, 70 % eight or fewer), each paying for a
-//!   whole lane group. 3 % faster (bunny, k = 258 and 1,026), and the same answer bit for
-//!   bit (a unit test compares them).
+//! * where a subtree is entered by [`single::ALONE`] = 4 live lanes or fewer, each walks it
+//!   alone (the `single` module): lanes diverge with depth, and on the bunny at k = 258
+//!   44 % of the internal nodes visited held one live lane (55 % two or fewer, 70 % eight or
+//!   fewer), each paying for a whole lane group. A lone ray tests four boxes per step — its
+//!   node's grandchildren, one per SSE lane — and gets the same answer as the lane groups
+//!   (a unit test compares them bit for bit). On the bunny at k = 258 (k = 1,026): one lane
+//!   through the binary tree 3 % faster, four boxes per step a further 10 % (10 %),
+//!   thresholds 2 / 4 / 6 / 8 / 12 lanes a further 2 / 4.5 / 3 / 2 / −1 %.
 //!
 //! Each node's box, slab and children sit in one 64-byte [`FanNode`], siblings in one
 //! 128-byte aligned [`NodePair`] (obvhs's `Bvh2Node` is 48 bytes and the slabs were an array
@@ -71,8 +74,10 @@ use crate::scene::Prepared;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod single;
 mod slab;
 
+use single::{ALONE, Quad, lanes_alone, quads};
 use slab::subtree_slabs;
 
 /// Rays per fan: one bit each of a `u64` mask.
@@ -477,6 +482,9 @@ pub(crate) struct FanTracer {
     nodes: Vec<Bvh2Node>,
     /// The same tree for the traversal, node `i` (shifted by `root`) at `packed[i / 2].0[i % 2]`.
     packed: Vec<NodePair>,
+    /// Per pair of siblings in `packed`, the grandchildren of their parent for
+    /// [`single_lane`].
+    quads: Vec<Quad>,
     /// The root's index in `packed`: 1 where obvhs puts siblings at odd-even indices, so
     /// that every pair of siblings shares a [`NodePair`].
     root: u32,
@@ -486,7 +494,8 @@ pub(crate) struct FanTracer {
     /// answer, bit for bit).
     wide: bool,
     /// Whether a fan's single live lane in a subtree goes on alone ([`single_lane`]): on
-    /// everywhere but in the test that shows it answers as the lane groups do.
+    /// wherever the [`Quad`]s could be built (always, with leaves of at most eight
+    /// triangles), off in the test that shows it answers as the lane groups do.
     single: bool,
 }
 
@@ -501,6 +510,7 @@ impl FanTracer {
         let mut tracer = Self {
             nodes,
             packed: Vec::new(),
+            quads: Vec::new(),
             root: 0,
             triangles,
             leaves,
@@ -546,6 +556,9 @@ impl FanTracer {
                 prim_count: node.prim_count,
             };
         }
+        let quads = quads(&flat);
+        self.single = quads.is_some();
+        self.quads = quads.unwrap_or_default();
         self.packed = flat
             .chunks_exact(2)
             .map(|p| NodePair([p[0], p[1]]))
@@ -619,13 +632,10 @@ impl FanTracer {
             if m == 0 {
                 continue;
             }
-            if self.single && m.is_power_of_two() {
-                let ray = fan.lane_ray(m.trailing_zeros() as usize);
-                if single_lane::<BOUNDED>(self, index, origin, ray, max_t, &mut single) {
-                    visible &= !m;
-                    if visible == 0 {
-                        return 0;
-                    }
+            if self.single && m.count_ones() <= ALONE {
+                visible &= !lanes_alone::<BOUNDED>(self, index, origin, fan, m, max_t, &mut single);
+                if visible == 0 {
+                    return 0;
                 }
                 continue;
             }
@@ -663,152 +673,6 @@ impl FanTracer {
             }
         }
         visible
-    }
-}
-
-/// One lane's ray, `origin + t·d` with its reciprocal `inv`, through the subtree at
-/// `index` (whose box it enters): whether it meets a triangle at 0 < t < `max_t`. The
-/// traversal of a fan's last live lane in a subtree. The same box, slab and triangle
-/// formulas as the lane groups' (same operand order, SSE's min/max, no fused multiply-add),
-/// so the answer is bit for bit theirs; only the whole-fan interval cull is skipped, whose
-/// bounds hold every lane's own interval (`single_lane_answers_as_lane_groups` compares
-/// them on a sheet whose origins lie on box faces).
-#[inline(always)]
-fn single_lane<const BOUNDED: bool>(
-    tracer: &FanTracer,
-    index: u32,
-    origin: Vec3A,
-    [d, inv]: [Vec3A; 2],
-    max_t: f32,
-    stack: &mut Vec<u32>,
-) -> bool {
-    stack.clear();
-    let mut next = index;
-    loop {
-        let node = tracer.node(next);
-        if node.prim_count > 0 {
-            let first = node.first_index as usize;
-            for t in &tracer.triangles[first..first + node.prim_count as usize] {
-                if triangle_single::<BOUNDED>(t, origin, d, max_t) {
-                    return true;
-                }
-            }
-        } else {
-            let first = node.first_index;
-            let (a, b) = (tracer.node(first), tracer.node(first + 1));
-            let hit_a = box_single::<BOUNDED>(a, origin, d, inv, max_t);
-            let hit_b = box_single::<BOUNDED>(b, origin, d, inv, max_t);
-            // The nearer child (by centre, as the lane groups order them) goes first.
-            let distance = |n: &FanNode| (n.min + n.max - 2.0 * origin).length_squared();
-            match (hit_a, hit_b) {
-                (true, true) => {
-                    let (near, far) = if distance(a) <= distance(b) {
-                        (first, first + 1)
-                    } else {
-                        (first + 1, first)
-                    };
-                    stack.push(far);
-                    next = near;
-                    continue;
-                }
-                (true, false) => {
-                    next = first;
-                    continue;
-                }
-                (false, true) => {
-                    next = first + 1;
-                    continue;
-                }
-                (false, false) => {}
-            }
-        }
-        match stack.pop() {
-            Some(n) => next = n,
-            None => return false,
-        }
-    }
-}
-
-/// `_mm_min_ps` on one lane: `b` where either is NaN.
-#[inline(always)]
-fn sse_min(a: f32, b: f32) -> f32 {
-    if a < b { a } else { b }
-}
-
-/// `_mm_max_ps` on one lane: `b` where either is NaN.
-#[inline(always)]
-fn sse_max(a: f32, b: f32) -> f32 {
-    if a > b { a } else { b }
-}
-
-/// [`box_lanes`] for one ray.
-#[inline(always)]
-fn box_single<const BOUNDED: bool>(
-    node: &FanNode,
-    origin: Vec3A,
-    d: Vec3A,
-    inv: Vec3A,
-    max_t: f32,
-) -> bool {
-    let low = node.min - origin;
-    let high = node.max - origin;
-    if low.cmple(Vec3A::ZERO).all() && high.cmpge(Vec3A::ZERO).all() {
-        return true;
-    }
-    let (t1, t2) = (low * inv, high * inv);
-    // The lane groups' operations in their order, with SSE's min/max (the second operand
-    // where either is NaN: 0·∞ where the origin lies on a box face and the direction along
-    // it) and a comparison that fails on NaN.
-    let (near, far) = (t1.min(t2), t1.max(t2));
-    let enter = sse_max(sse_max(near.x, near.y), sse_max(near.z, 0.0));
-    let leave = sse_min(sse_min(far.x, far.y), far.z);
-    let leave = if BOUNDED {
-        sse_min(leave, max_t)
-    } else {
-        leave
-    };
-    #[allow(clippy::neg_cmp_op_on_partial_ord)]
-    if !(enter <= leave) {
-        return false;
-    }
-    if node.half.is_finite() {
-        let n = node.normal;
-        let s0 = node.normal.dot(origin) - node.centre;
-        let along = d.x * n.x + d.y * n.y + d.z * n.z;
-        let (a, b) = (s0 + enter * along, s0 + leave * along);
-        let half = node.half;
-        if (a > half && b > half) || (a < -half && b < -half) {
-            return false;
-        }
-    }
-    true
-}
-
-/// [`triangle_lanes`] for one ray.
-#[inline(always)]
-fn triangle_single<const BOUNDED: bool>(
-    t: &FanTriangle,
-    origin: Vec3A,
-    d: Vec3A,
-    max_t: f32,
-) -> bool {
-    let [a, b, c] = t.0.map(|v| v - origin);
-    let (mut n0, mut n1, mut n2) = (b.cross(c), c.cross(a), a.cross(b));
-    let mut det = a.dot(n0);
-    if det == 0.0 || !det.is_finite() {
-        return false;
-    }
-    let sign = 1.0f32.copysign(det);
-    (n0, n1, n2, det) = (n0 * sign, n1 * sign, n2 * sign, det * sign);
-    let e = |n: Vec3A| d.x * n.x + d.y * n.y + d.z * n.z;
-    let (e0, e1, e2) = (e(n0), e(n1), e(n2));
-    let sum = e0 + e1 + e2;
-    let tol = sum * -EDGE_TOLERANCE;
-    let hit = sse_min(sse_min(e0, e1), e2) >= tol;
-    if BOUNDED {
-        hit && det < sum * max_t
-    } else {
-        hit
     }
 }
 

@@ -14,7 +14,7 @@ use std::arch::x86_64::{
 
 use glam::{Vec3A, Vec4};
 
-use super::{FanNode, FanSetup, FanTracer, FanTriangle, GROUPS, RayFan, single_lane};
+use super::{ALONE, FanNode, FanSetup, FanTracer, FanTriangle, GROUPS, RayFan, lanes_alone};
 use crate::cpu::EDGE_TOLERANCE;
 
 /// Lanes per AVX2 group.
@@ -82,13 +82,10 @@ pub(super) fn traverse<const BOUNDED: bool>(
         if m == 0 {
             continue;
         }
-        if tracer.single && m.is_power_of_two() {
-            let ray = fan.lane_ray(m.trailing_zeros() as usize);
-            if single_lane::<BOUNDED>(tracer, index, origin, ray, max_t, &mut single) {
-                visible &= !m;
-                if visible == 0 {
-                    return 0;
-                }
+        if tracer.single && m.count_ones() <= ALONE {
+            visible &= !lanes_alone::<BOUNDED>(tracer, index, origin, fan, m, max_t, &mut single);
+            if visible == 0 {
+                return 0;
             }
             continue;
         }

@@ -1,0 +1,291 @@
+//! One ray through a subtree: a fan's last live lane, walked alone.
+//!
+//! Lanes diverge with depth: on the bunny at k = 258, 44 % of the internal nodes the fans
+//! visited held a single live lane (55 % two or fewer, 70 % eight or fewer), each paying for
+//! a whole lane group. Such a lane leaves the fan and walks the rest of the subtree on its
+//! own, four boxes at a time: every internal node carries a [`Quad`], its grandchildren's
+//! boxes and slabs lane by lane (a child that is a leaf stands in for its two), so one SIMD
+//! pass tests two levels of the binary tree.
+
+use glam::{BVec4A, Vec3A, Vec4};
+
+use super::{FanNode, FanTracer, FanTriangle, RayFan};
+use crate::cpu::EDGE_TOLERANCE;
+
+/// A [`Quad`] entry that is a leaf: its first triangle in the low 28 bits, its count less one
+/// in the next three.
+const LEAF: u32 = 1 << 31;
+/// Bits of a leaf entry's first triangle.
+const FIRST_BITS: u32 = 28;
+/// An unused [`Quad`] entry.
+const EMPTY: u32 = u32::MAX;
+
+/// Up to four boxes and slabs, one per SIMD lane, and what each leads to: a leaf's triangles
+/// or the next [`Quad`]. Three cache lines.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(super) struct Quad {
+    min: [Vec4; 3],
+    max: [Vec4; 3],
+    normal: [Vec4; 3],
+    centre: Vec4,
+    half: Vec4,
+    /// `LEAF | (count − 1) << FIRST_BITS | first` for a leaf, the [`Quad`] of its
+    /// grandchildren for an internal node, [`EMPTY`] for none.
+    entry: [u32; 4],
+}
+
+impl Quad {
+    const EMPTY: Self = Self {
+        min: [Vec4::ZERO; 3],
+        max: [Vec4::ZERO; 3],
+        normal: [Vec4::ZERO; 3],
+        centre: Vec4::ZERO,
+        half: Vec4::INFINITY,
+        entry: [EMPTY; 4],
+    };
+
+    /// Lanes holding an entry.
+    #[inline(always)]
+    fn valid(&self) -> u32 {
+        BVec4A::new(
+            self.entry[0] != EMPTY,
+            self.entry[1] != EMPTY,
+            self.entry[2] != EMPTY,
+            self.entry[3] != EMPTY,
+        )
+        .bitmask()
+    }
+}
+
+/// The [`Quad`] of every pair of siblings in `flat` (the traversal's nodes, siblings at
+/// indices 2p and 2p + 1): quad p holds the grandchildren of the pair's parent. `None` where a
+/// leaf does not fit an entry (more than eight triangles, or a first triangle past 2²⁸) or
+/// siblings straddle two pairs.
+pub(super) fn quads(flat: &[FanNode]) -> Option<Vec<Quad>> {
+    let leaf = |n: &FanNode| {
+        (n.prim_count <= 8 && n.first_index < 1 << FIRST_BITS)
+            .then(|| LEAF | (n.prim_count - 1) << FIRST_BITS | n.first_index)
+    };
+    let mut out = vec![Quad::EMPTY; flat.len() / 2];
+    for (p, quad) in out.iter_mut().enumerate() {
+        let mut lane = 0;
+        for child in &flat[2 * p..2 * p + 2] {
+            let under: &[FanNode] = if child.prim_count > 0 {
+                std::slice::from_ref(child)
+            } else if child.first_index == 0 {
+                // The padding before the root (no children) or an empty tree.
+                &[]
+            } else if child.first_index % 2 == 1 {
+                // Siblings that straddle two pairs.
+                return None;
+            } else {
+                let first = child.first_index as usize;
+                &flat[first..first + 2]
+            };
+            for n in under {
+                quad.entry[lane] = if n.prim_count > 0 {
+                    leaf(n)?
+                } else {
+                    n.first_index / 2
+                };
+                for axis in 0..3 {
+                    quad.min[axis][lane] = n.min[axis];
+                    quad.max[axis][lane] = n.max[axis];
+                    quad.normal[axis][lane] = n.normal[axis];
+                }
+                quad.centre[lane] = n.centre;
+                quad.half[lane] = n.half;
+                lane += 1;
+            }
+        }
+    }
+    Some(out)
+}
+
+/// Live lanes at or below which a fan's lanes leave it and walk a subtree alone.
+pub(super) const ALONE: u32 = 4;
+
+/// The lanes of `mask` (at most [`ALONE`]) whose rays, walked alone through the subtree at
+/// `index`, meet a triangle at 0 < t < `max_t`.
+#[inline(always)]
+pub(super) fn lanes_alone<const BOUNDED: bool>(
+    tracer: &FanTracer,
+    index: u32,
+    origin: Vec3A,
+    fan: &RayFan,
+    mask: u64,
+    max_t: f32,
+    stack: &mut Vec<u32>,
+) -> u64 {
+    let mut hit = 0;
+    let mut rest = mask;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        if single_lane::<BOUNDED>(tracer, index, origin, fan.lane_ray(lane), max_t, stack) {
+            hit |= 1 << lane;
+        }
+    }
+    hit
+}
+
+/// A ray splatted across lanes.
+struct Ray4 {
+    origin: [Vec4; 3],
+    d: [Vec4; 3],
+    inv: [Vec4; 3],
+    /// n·o is taken from `origin3` as the lane groups take it (a `Vec3A` dot product).
+    origin3: Vec3A,
+}
+
+/// One lane's ray, `origin + t·d` with its reciprocal `inv`, through the subtree at `index`
+/// (whose box it enters): whether it meets a triangle at 0 < t < `max_t`. The lane groups'
+/// box, slab and triangle formulas in their operand order (SSE's min/max, no fused
+/// multiply-add); the interval cull of the whole fan and the tests of every second level's
+/// boxes are skipped, which in exact arithmetic never changes an answer — a ray meets a
+/// triangle only inside every box and slab above it (`single_lane_answers_as_lane_groups`
+/// compares them on a sheet whose origins lie on box faces).
+#[inline(always)]
+fn single_lane<const BOUNDED: bool>(
+    tracer: &FanTracer,
+    index: u32,
+    origin: Vec3A,
+    [d, inv]: [Vec3A; 2],
+    max_t: f32,
+    stack: &mut Vec<u32>,
+) -> bool {
+    let node = tracer.node(index);
+    let first = node.first_index;
+    if node.prim_count > 0 {
+        return leaf_hit::<BOUNDED>(tracer, first, node.prim_count, origin, d, max_t);
+    }
+    let ray = Ray4 {
+        origin: [0, 1, 2].map(|k| Vec4::splat(origin[k])),
+        d: [0, 1, 2].map(|k| Vec4::splat(d[k])),
+        inv: [0, 1, 2].map(|k| Vec4::splat(inv[k])),
+        origin3: origin,
+    };
+    stack.clear();
+    let mut entry = first / 2;
+    loop {
+        if entry & LEAF != 0 {
+            let count = (entry >> FIRST_BITS & 7) + 1;
+            let first = entry & ((1 << FIRST_BITS) - 1);
+            if leaf_hit::<BOUNDED>(tracer, first, count, origin, d, max_t) {
+                return true;
+            }
+        } else {
+            let quad = &tracer.quads[entry as usize];
+            let (hits, enter) = quad_hits::<BOUNDED>(quad, &ray, max_t);
+            let mut hits = hits & quad.valid();
+            if hits != 0 {
+                // Nearest entry first: the others go on the stack, farthest at the bottom.
+                let enter = enter.to_array();
+                let mut order = [(0.0f32, 0u32); 4];
+                let mut n = 0;
+                while hits != 0 {
+                    let lane = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    let mut i = n;
+                    while i > 0 && order[i - 1].0 < enter[lane] {
+                        order[i] = order[i - 1];
+                        i -= 1;
+                    }
+                    order[i] = (enter[lane], quad.entry[lane]);
+                    n += 1;
+                }
+                stack.extend(order[..n - 1].iter().map(|&(_, e)| e));
+                entry = order[n - 1].1;
+                continue;
+            }
+        }
+        match stack.pop() {
+            Some(e) => entry = e,
+            None => return false,
+        }
+    }
+}
+
+/// The lanes of `quad` whose box (and slab) the ray enters before `max_t`, and where it
+/// enters each: the lane groups' `box_lanes` with boxes across the lanes.
+#[inline(always)]
+fn quad_hits<const BOUNDED: bool>(quad: &Quad, ray: &Ray4, max_t: f32) -> (u32, Vec4) {
+    let low = [0, 1, 2].map(|k| quad.min[k] - ray.origin[k]);
+    let high = [0, 1, 2].map(|k| quad.max[k] - ray.origin[k]);
+    // A box around the origin: entered, whatever its slab says.
+    let contains = low[0].cmple(Vec4::ZERO)
+        & low[1].cmple(Vec4::ZERO)
+        & low[2].cmple(Vec4::ZERO)
+        & high[0].cmpge(Vec4::ZERO)
+        & high[1].cmpge(Vec4::ZERO)
+        & high[2].cmpge(Vec4::ZERO);
+    let (x1, x2) = (low[0] * ray.inv[0], high[0] * ray.inv[0]);
+    let (y1, y2) = (low[1] * ray.inv[1], high[1] * ray.inv[1]);
+    let (z1, z2) = (low[2] * ray.inv[2], high[2] * ray.inv[2]);
+    let enter = x1.min(x2).max(y1.min(y2)).max(z1.min(z2).max(Vec4::ZERO));
+    let leave = x1.max(x2).min(y1.max(y2)).min(z1.max(z2));
+    let leave = if BOUNDED {
+        leave.min(Vec4::splat(max_t))
+    } else {
+        leave
+    };
+    let mut inside = enter.cmple(leave);
+    // The slab: both ends beyond the same face (never for an unbounded one, half = ∞).
+    let [nx, ny, nz] = quad.normal;
+    let o = ray.origin3;
+    let s0 = nx * o.x + ny * o.y + nz * o.z - quad.centre;
+    let along = ray.d[0] * nx + ray.d[1] * ny + ray.d[2] * nz;
+    let (a, b) = (s0 + enter * along, s0 + leave * along);
+    let above = a.cmpgt(quad.half) & b.cmpgt(quad.half);
+    let below = a.cmplt(-quad.half) & b.cmplt(-quad.half);
+    inside &= !(above | below);
+    ((inside | contains).bitmask(), enter)
+}
+
+/// Whether the ray meets one of the `count` triangles from `first`. (Four triangles across
+/// the lanes of one test, gathered from the leaf, were no faster: a leaf holds 4.4 on
+/// average, and the first hit ends the scalar loop.)
+#[inline(always)]
+fn leaf_hit<const BOUNDED: bool>(
+    tracer: &FanTracer,
+    first: u32,
+    count: u32,
+    origin: Vec3A,
+    d: Vec3A,
+    max_t: f32,
+) -> bool {
+    let first = first as usize;
+    tracer.triangles[first..first + count as usize]
+        .iter()
+        .any(|t| triangle_hit::<BOUNDED>(t, origin, d, max_t))
+}
+
+/// `_mm_min_ps` on one lane: `b` where either is NaN.
+#[inline(always)]
+fn sse_min(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+/// The lane groups' `triangle_lanes` for one ray.
+#[inline(always)]
+fn triangle_hit<const BOUNDED: bool>(t: &FanTriangle, origin: Vec3A, d: Vec3A, max_t: f32) -> bool {
+    let [a, b, c] = t.0.map(|v| v - origin);
+    let (mut n0, mut n1, mut n2) = (b.cross(c), c.cross(a), a.cross(b));
+    let mut det = a.dot(n0);
+    if det == 0.0 || !det.is_finite() {
+        return false;
+    }
+    let sign = 1.0f32.copysign(det);
+    (n0, n1, n2, det) = (n0 * sign, n1 * sign, n2 * sign, det * sign);
+    let e = |n: Vec3A| d.x * n.x + d.y * n.y + d.z * n.z;
+    let (e0, e1, e2) = (e(n0), e(n1), e(n2));
+    let sum = e0 + e1 + e2;
+    let tol = sum * -EDGE_TOLERANCE;
+    let hit = sse_min(sse_min(e0, e1), e2) >= tol;
+    if BOUNDED {
+        hit && det < sum * max_t
+    } else {
+        hit
+    }
+}
