@@ -28,10 +28,10 @@
 //!
 //! [`CpuMethod::Auto`] (the default) takes fans when a call computes at least
 //! [`FAN_MIN_COLUMNS`] columns and packets below. Measured on the full bunny (35,947
-//! vertices, BVH build included, best of 9 runs on 2 threads): packets 70.6 / 179 / 560 /
-//! 2,021 ms at k = 18 / 66 / 258 / 1026, fans 74.3 / 132 / 316 / 824 ms (before the
-//! per-vertex runs, slabs and AVX2 of issue #20: 427 / 1,171 ms at k = 258 / 1026 in the
-//! same session). With few directions a vertex's fan is nearly empty and the per-fan set-up
+//! vertices, BVH build included, best of 9 runs on 2 threads): packets 31.8 / 55.5 / 151 /
+//! 502 / 1,831 ms at k = 6 / 18 / 66 / 258 / 1026, fans 43.8 / 47.0 / 80.8 / 216 / 633 ms
+//! (before issue #20: fans 427 / 1,171 ms at k = 258 / 1026, and slower than packets up to
+//! k = 18). With few directions a vertex's fan is nearly empty and the per-fan set-up
 //! dominates; with many, the shared origin pays. Same M: at k = 258 no entry of the 9.3 M
 //! differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing rays). A
 //! per-direction uniform grid of the projected triangles was also tried and dropped: its
@@ -82,18 +82,18 @@ pub enum CpuMethod {
     /// default: the faster of the two on either side).
     #[default]
     Auto,
-    /// Packets of up to 64 parallel rays through a binary BVH (faster for k ≤ 18).
+    /// Packets of up to 64 parallel rays through a binary BVH (faster for k ≤ 6).
     Packets,
     /// One traversal per ray of an 8-wide compressed BVH, with a shadow cache.
     SingleRays,
     /// Fans: each vertex's directions in fans of up to 64 from its origin (faster for
-    /// k ≥ 66).
+    /// k ≥ 18).
     Fans,
 }
 
-/// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 18 (packets
-/// 5 % faster) and k = 66 (fans 1.36× faster).
-pub const FAN_MIN_COLUMNS: usize = 32;
+/// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 6 (packets
+/// 1.38× faster) and k = 18 (fans 1.18× faster).
+pub const FAN_MIN_COLUMNS: usize = 12;
 
 impl CpuMethod {
     /// The traversal this method runs for a call computing `columns` columns.
