@@ -8,11 +8,12 @@
 //! (ratio − 1) × the fresh tree's traversal time and the extra time measured on the last
 //! refitted frame — stays below the last build's time (measured, so the rule adapts to k and
 //! to the mesh), and never beyond [`REBUILD_SAH_RATIO`]. On the drape at k = 258 a traversal
-//! of ~30 ms against a 3.5 ms build tolerates ~10 % of degradation; a fixed 1.5 cap alone
+//! of ~24 ms against a 4 ms build tolerates ~15 % of degradation; a fixed 1.5 cap alone
 //! made refitting 7.5 % slower than rebuilding every frame there, and the SAH ratio alone
 //! (which underestimates the slowdown of the slab-culled fan traversal) 10 % slower. Per frame
-//! (`benches/deforming.rs`, one run): drape k = 258 30.6 ms refitting against 34.0 ms
-//! rebuilding, k = 66 11.8 vs 14.2; the chicken at k = 258 24.3 vs 25.0, k = 66 9.5 vs 11.0.
+//! (`benches/deforming.rs`, one run, medians): drape k = 258 24.6 ms refitting against
+//! 28.1 ms rebuilding, k = 66 8.9 vs 11.8; the chicken at k = 258 20.6 vs 22.5, k = 66 7.5 vs
+//! 9.4.
 
 use std::time::Duration;
 
