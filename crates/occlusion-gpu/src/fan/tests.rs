@@ -35,6 +35,19 @@ fn crumpled() -> Scene {
     Scene::single(positions, normals, triangles).unwrap()
 }
 
+/// The crumpled sheet, its fan tracer and the fans of the level-3 lightsphere.
+fn sheet_and_fans() -> (Prepared, FanTracer, Vec<RayFan>) {
+    let prepared = Prepared::new(&crumpled()).unwrap();
+    let tracer = FanTracer::new(&prepared, BvhBuildParams::medium_build());
+    let sphere = lightsphere::Lightsphere::new(3).unwrap();
+    let directions: Vec<Vec3> = sphere.directions().to_vec();
+    let fans = fan_groups(&directions)
+        .iter()
+        .map(|g| RayFan::from_group(&directions, g))
+        .collect();
+    (prepared, tracer, fans)
+}
+
 /// The AVX2 traversal answers every lane exactly as the four-lane one: same bits for
 /// every vertex of a crumpled sheet, every fan of the level-3 lightsphere, to infinity
 /// and within a finite distance.
@@ -44,14 +57,7 @@ fn eight_lanes_answer_as_four_lanes() {
         eprintln!("skipping: this CPU has no AVX2");
         return;
     }
-    let prepared = Prepared::new(&crumpled()).unwrap();
-    let tracer = FanTracer::new(&prepared, BvhBuildParams::medium_build());
-    let sphere = lightsphere::Lightsphere::new(3).unwrap();
-    let directions: Vec<Vec3> = sphere.directions().to_vec();
-    let fans: Vec<RayFan> = fan_groups(&directions)
-        .iter()
-        .map(|g| RayFan::from_group(&directions, g))
-        .collect();
+    let (prepared, tracer, fans) = sheet_and_fans();
     let (mut lanes, mut open, mut differ) = (0u32, 0u32, 0u32);
     for receiver in &prepared.receivers {
         let origin = Vec3A::from(receiver.position) + Vec3A::Y * 1e-3;
@@ -77,21 +83,14 @@ fn eight_lanes_answer_as_four_lanes() {
     );
 }
 
-/// A fan's last live lane, traced alone through the rest of a subtree ([`super::single_lane`]),
-/// answers as the lane groups do: same bits for every vertex of the crumpled sheet (from the
+/// The lanes a fan hands to lone walks (four or fewer live in a subtree, four boxes per
+/// step, the `single` module) answer as the lane groups do: same bits for every vertex of the crumpled sheet (from the
 /// vertex itself, where the grid's integer coordinates put origins on box faces and the
 /// lightsphere's axis directions make 0·∞, and from just above it), every fan of the level-3
 /// lightsphere, to infinity and within a finite distance.
 #[test]
 fn single_lane_answers_as_lane_groups() {
-    let prepared = Prepared::new(&crumpled()).unwrap();
-    let mut tracer = FanTracer::new(&prepared, BvhBuildParams::medium_build());
-    let sphere = lightsphere::Lightsphere::new(3).unwrap();
-    let directions: Vec<Vec3> = sphere.directions().to_vec();
-    let fans: Vec<RayFan> = fan_groups(&directions)
-        .iter()
-        .map(|g| RayFan::from_group(&directions, g))
-        .collect();
+    let (prepared, mut tracer, fans) = sheet_and_fans();
     let trace = |tracer: &FanTracer| {
         let mut out = Vec::new();
         for receiver in &prepared.receivers {
