@@ -171,7 +171,7 @@ impl CpuParams {
     /// Checks [`CpuParams::max_distance`].
     ///
     /// # Errors
-    /// [`OcclusionError::InvalidParameter`] when it is NaN or not > 0.
+    /// [`crate::OcclusionError::InvalidParameter`] when it is NaN or not > 0.
     pub(crate) fn validate(&self) -> Result<(), crate::OcclusionError> {
         if self.max_distance > 0.0 {
             Ok(())

@@ -18,7 +18,7 @@
 //!   centre is nearer the origin is visited first (near occluders end lanes early: 1.1–1.5×
 //!   faster than ordering along the fan's mean direction, which the nearest point of the box
 //!   or the entry distance of the interval test also lose to);
-//! * every subtree of at most 1,024 triangles also carries a [`Slab`], the two planes along
+//! * every subtree of at most 1,024 triangles also carries a [`slab::Slab`], the two planes along
 //!   its area-weighted normal that hold its triangles: a lane whose ray enters and leaves the
 //!   box on the same side of the slab is dropped. A surface patch is much thinner than its
 //!   box, and the rays that graze the surface near their origin cross the boxes of the
@@ -454,7 +454,7 @@ fn live_groups(mask: u64) -> u64 {
 #[derive(Clone, Copy, Debug)]
 struct FanTriangle([Vec3A; 3]);
 
-/// A node as the traversal reads it: its box, the [`Slab`] of its subtree's triangles
+/// A node as the traversal reads it: its box, the [`slab::Slab`] of its subtree's triangles
 /// (unbounded for large subtrees) and its children or triangles, in one cache line.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
@@ -482,8 +482,8 @@ pub(crate) struct FanTracer {
     nodes: Vec<Bvh2Node>,
     /// The same tree for the traversal, node `i` (shifted by `root`) at `packed[i / 2].0[i % 2]`.
     packed: Vec<NodePair>,
-    /// Per pair of siblings in `packed`, the grandchildren of their parent for
-    /// [`single_lane`].
+    /// Per pair of siblings in `packed`, the grandchildren of their parent, for the lone
+    /// walks ([`lanes_alone`]).
     quads: Vec<Quad>,
     /// The root's index in `packed`: 1 where obvhs puts siblings at odd-even indices, so
     /// that every pair of siblings shares a [`NodePair`].
@@ -493,9 +493,9 @@ pub(crate) struct FanTracer {
     /// Whether the CPU runs AVX2: lanes tested eight at a time instead of four (the same
     /// answer, bit for bit).
     wide: bool,
-    /// Whether a fan's single live lane in a subtree goes on alone ([`single_lane`]): on
-    /// wherever the [`Quad`]s could be built (always, with leaves of at most eight
-    /// triangles), off in the test that shows it answers as the lane groups do.
+    /// Whether a subtree entered by [`ALONE`] live lanes or fewer is walked by each alone
+    /// ([`lanes_alone`]): on wherever the [`Quad`]s could be built (always, with leaves of at
+    /// most eight triangles), off in the test that shows it answers as the lane groups do.
     single: bool,
 }
 

@@ -13,9 +13,10 @@
 //! (an occlusion query with polygon offset also counts pixels that tie in depth). A triangle
 //! smaller than a pixel that covers no pixel centre is not visible, so it is neither computed
 //! nor drawn at that resolution. Both faces are rasterised (cloth is seen from both sides).
-//! [`visible_triangles_cpu`] is the CPU reference (and the path without an adapter): the same
-//! pixel-centre sampling with an inclusive edge rule instead of the GPU's top-left rule, so the
-//! two may differ on triangles that only touch pixel centres with an edge.
+//! [`super::raster::visible_triangles_cpu`] is the CPU reference (and the path without an
+//! adapter): the same pixel-centre sampling with an inclusive edge rule instead of the GPU's
+//! top-left rule, so the two may differ on triangles that only touch pixel centres with an
+//! edge.
 
 use glam::Vec3;
 use wgpu::util::DeviceExt;
