@@ -476,6 +476,19 @@ struct FanNode {
 #[repr(C, align(128))]
 struct NodePair([FanNode; 2]);
 
+/// The traversal's stacks: the fan's (node, lanes) and the lone walks' entries.
+#[derive(Default)]
+struct Stacks {
+    fan: Vec<(u32, u64)>,
+    single: Vec<u32>,
+}
+
+thread_local! {
+    /// Each thread's [`Stacks`], allocated once rather than once per fan (the bunny at
+    /// k = 258 traces 104,502 fans).
+    static STACKS: std::cell::RefCell<Stacks> = std::cell::RefCell::default();
+}
+
 /// The scene's binary BVH for fans, triangles in leaf order.
 pub(crate) struct FanTracer {
     /// The tree as built and refitted.
@@ -587,24 +600,26 @@ impl FanTracer {
 
     /// The lanes of `mask` whose rays `origin + t·d`, 0 < t < `max_t`, meet no triangle.
     pub(crate) fn unoccluded(&self, origin: Vec3A, fan: &RayFan, mask: u64, max_t: f32) -> u64 {
-        #[cfg(target_arch = "x86_64")]
-        if self.wide {
-            // SAFETY: `wide` is set only where `is_x86_feature_detected!("avx2")` said so.
-            #[allow(unsafe_code)]
-            return unsafe {
-                if max_t == f32::INFINITY {
-                    avx2::traverse::<false>(self, origin, fan, mask, max_t)
-                } else {
-                    avx2::traverse::<true>(self, origin, fan, mask, max_t)
-                }
-            };
-        }
-        // Two instances: rays to infinity skip the distance comparisons.
-        if max_t == f32::INFINITY {
-            self.traverse::<false>(origin, fan, mask, max_t)
-        } else {
-            self.traverse::<true>(origin, fan, mask, max_t)
-        }
+        STACKS.with_borrow_mut(|stacks| {
+            #[cfg(target_arch = "x86_64")]
+            if self.wide {
+                // SAFETY: `wide` is set only where `is_x86_feature_detected!("avx2")` said so.
+                #[allow(unsafe_code)]
+                return unsafe {
+                    if max_t == f32::INFINITY {
+                        avx2::traverse::<false>(self, origin, fan, mask, max_t, stacks)
+                    } else {
+                        avx2::traverse::<true>(self, origin, fan, mask, max_t, stacks)
+                    }
+                };
+            }
+            // Two instances: rays to infinity skip the distance comparisons.
+            if max_t == f32::INFINITY {
+                self.traverse::<false>(origin, fan, mask, max_t, stacks)
+            } else {
+                self.traverse::<true>(origin, fan, mask, max_t, stacks)
+            }
+        })
     }
 
     #[inline(always)]
@@ -614,6 +629,7 @@ impl FanTracer {
         fan: &RayFan,
         mask: u64,
         max_t: f32,
+        stacks: &mut Stacks,
     ) -> u64 {
         let mask = mask & fan.full_mask();
         if self.nodes.is_empty() || mask == 0 {
@@ -621,8 +637,8 @@ impl FanTracer {
         }
         let inv = FanSetup::new(fan, mask);
         let mut visible = mask;
-        let mut stack: Vec<(u32, u64)> = Vec::with_capacity(64);
-        let mut single = Vec::with_capacity(64);
+        let Stacks { fan: stack, single } = stacks;
+        stack.clear();
         let root = box_lanes::<BOUNDED>(self.node(self.root), origin, &inv, fan, mask, max_t);
         if root != 0 {
             stack.push((self.root, root));
@@ -633,7 +649,7 @@ impl FanTracer {
                 continue;
             }
             if self.single && m.count_ones() <= ALONE {
-                visible &= !lanes_alone::<BOUNDED>(self, index, origin, fan, m, max_t, &mut single);
+                visible &= !lanes_alone::<BOUNDED>(self, index, origin, fan, m, max_t, single);
                 if visible == 0 {
                     return 0;
                 }

@@ -14,7 +14,9 @@ use std::arch::x86_64::{
 
 use glam::{Vec3A, Vec4};
 
-use super::{ALONE, FanNode, FanSetup, FanTracer, FanTriangle, GROUPS, RayFan, lanes_alone};
+use super::{
+    ALONE, FanNode, FanSetup, FanTracer, FanTriangle, GROUPS, RayFan, Stacks, lanes_alone,
+};
 use crate::cpu::EDGE_TOLERANCE;
 
 /// Lanes per AVX2 group.
@@ -55,6 +57,7 @@ pub(super) fn traverse<const BOUNDED: bool>(
     fan: &RayFan,
     mask: u64,
     max_t: f32,
+    stacks: &mut Stacks,
 ) -> u64 {
     let mask = mask & fan.full_mask();
     if tracer.nodes.is_empty() || mask == 0 {
@@ -71,8 +74,8 @@ pub(super) fn traverse<const BOUNDED: bool>(
         setup: &setup,
     };
     let mut visible = mask;
-    let mut stack: Vec<(u32, u64)> = Vec::with_capacity(64);
-    let mut single = Vec::with_capacity(64);
+    let Stacks { fan: stack, single } = stacks;
+    stack.clear();
     let root = box_lanes::<BOUNDED>(tracer.node(tracer.root), origin, &wide, mask, max_t);
     if root != 0 {
         stack.push((tracer.root, root));
@@ -83,7 +86,7 @@ pub(super) fn traverse<const BOUNDED: bool>(
             continue;
         }
         if tracer.single && m.count_ones() <= ALONE {
-            visible &= !lanes_alone::<BOUNDED>(tracer, index, origin, fan, m, max_t, &mut single);
+            visible &= !lanes_alone::<BOUNDED>(tracer, index, origin, fan, m, max_t, single);
             if visible == 0 {
                 return 0;
             }

@@ -3,7 +3,7 @@
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 
-use super::{FanTracer, RayFan, fan_groups};
+use super::{FanTracer, RayFan, Stacks, fan_groups};
 use crate::scene::{Prepared, Scene};
 
 /// A crumpled sheet: a 40 × 40 grid with pseudo-random heights, so rays from it graze,
@@ -59,15 +59,16 @@ fn eight_lanes_answer_as_four_lanes() {
     }
     let (prepared, tracer, fans) = sheet_and_fans();
     let (mut lanes, mut open, mut differ) = (0u32, 0u32, 0u32);
+    let mut stacks = Stacks::default();
     for receiver in &prepared.receivers {
         let origin = Vec3A::from(receiver.position) + Vec3A::Y * 1e-3;
         for fan in &fans {
             let mask = fan.full_mask();
             for max_t in [f32::INFINITY, 5.0] {
                 let four = if max_t == f32::INFINITY {
-                    tracer.traverse::<false>(origin, fan, mask, max_t)
+                    tracer.traverse::<false>(origin, fan, mask, max_t, &mut stacks)
                 } else {
-                    tracer.traverse::<true>(origin, fan, mask, max_t)
+                    tracer.traverse::<true>(origin, fan, mask, max_t, &mut stacks)
                 };
                 let eight = tracer.unoccluded(origin, fan, mask, max_t);
                 lanes += mask.count_ones();
