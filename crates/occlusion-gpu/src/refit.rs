@@ -158,16 +158,27 @@ pub(crate) fn padded_bvh2(
     let mut params = quality;
     params.max_prims_per_leaf = leaf_size;
     let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
-    let ordered = bvh
-        .primitive_indices
-        .iter()
-        .map(|&i| tris[i as usize])
-        .collect();
     let mut nodes = bvh.nodes;
+    // The leaves renumbered depth-first (obvhs's PLOC leaves them in build order), so that
+    // every subtree's triangles are one range of the leaf order (the fan slabs' bounds).
+    let mut order = Vec::with_capacity(bvh.primitive_indices.len());
+    let mut stack = vec![0usize];
+    while let Some(i) = stack.pop() {
+        let node = &mut nodes[i];
+        if node.prim_count > 0 {
+            let first = node.first_index as usize;
+            node.first_index = order.len() as u32;
+            order
+                .extend_from_slice(&bvh.primitive_indices[first..first + node.prim_count as usize]);
+        } else {
+            stack.extend([node.first_index as usize + 1, node.first_index as usize]);
+        }
+    }
+    let ordered = order.iter().map(|&i| tris[i as usize]).collect();
     for node in &mut nodes {
         pad(&mut node.aabb, prepared.diagonal);
     }
-    let leaves = LeafOrder::new(&nodes, bvh.primitive_indices);
+    let leaves = LeafOrder::new(&nodes, order);
     (nodes, ordered, leaves)
 }
 

@@ -30,14 +30,11 @@ impl Slab {
         half: f32::INFINITY,
     };
 
-    /// The slab along the triangles' area-weighted normal, padded by 1e-5 × `diagonal` (the
-    /// scene's coordinates are centred, so rounding in n·x stays far below that).
-    fn around(triangles: impl Iterator<Item = [Vec3A; 3]> + Clone, diagonal: f32) -> Self {
-        let normal = triangles
-            .clone()
-            .map(|[a, b, c]| (b - a).cross(c - a))
-            .sum::<Vec3A>()
-            .normalize_or_zero();
+    /// The slab of `triangles` along `area` (the sum of their area-weighted normals), padded
+    /// by 1e-5 × `diagonal` (the scene's coordinates are centred, so rounding in n·x stays
+    /// far below that).
+    fn around(area: Vec3A, triangles: impl Iterator<Item = [Vec3A; 3]>, diagonal: f32) -> Self {
+        let normal = area.normalize_or_zero();
         if normal == Vec3A::ZERO {
             return Self::UNBOUNDED;
         }
@@ -63,35 +60,44 @@ pub(super) fn subtree_slabs(
     triangles: &[FanTriangle],
     diagonal: f32,
 ) -> Vec<Slab> {
-    // Triangles under each node, bottom-up.
-    let mut count = vec![0u32; nodes.len()];
+    // Bottom-up: each subtree's triangles as a range of the leaf order (contiguous: see
+    // `padded_bvh2`) and its area-weighted normal, the sum of its children's. (Gathering each
+    // subtree's triangles by walking it took 5.6 ms on the bunny, the ranges 2.0.)
+    let area = |t: &FanTriangle| {
+        let [a, b, c] = t.0;
+        (b - a).cross(c - a)
+    };
+    let mut under = vec![(0u32, 0u32, Vec3A::ZERO); nodes.len()];
+    let mut contiguous = true;
     for &i in &leaves.bottom_up {
         let node = &nodes[i as usize];
-        count[i as usize] = if node.prim_count > 0 {
-            node.prim_count
+        under[i as usize] = if node.prim_count > 0 {
+            let (first, end) = (node.first_index, node.first_index + node.prim_count);
+            let sum = triangles[first as usize..end as usize]
+                .iter()
+                .map(area)
+                .sum();
+            (first, end, sum)
         } else {
             let c = node.first_index as usize;
-            count[c] + count[c + 1]
+            let ((a0, a1, an), (b0, b1, bn)) = (under[c], under[c + 1]);
+            contiguous &= a1 == b0 || b1 == a0;
+            (a0.min(b0), a1.max(b1), an + bn)
         };
     }
-    (0..nodes.len())
-        .into_par_iter()
-        .map_init(Vec::new, |under: &mut Vec<FanTriangle>, i| {
-            if count[i] > SLAB_MAX_TRIANGLES {
+    if !contiguous {
+        // Not a tree from `padded_bvh2` (which numbers leaves depth-first): no slabs, still
+        // the right answer.
+        return vec![Slab::UNBOUNDED; nodes.len()];
+    }
+    under
+        .par_iter()
+        .map(|&(first, end, area)| {
+            if end - first > SLAB_MAX_TRIANGLES {
                 return Slab::UNBOUNDED;
             }
-            under.clear();
-            let mut stack = vec![i];
-            while let Some(n) = stack.pop() {
-                let node = &nodes[n];
-                if node.prim_count > 0 {
-                    let first = node.first_index as usize;
-                    under.extend(&triangles[first..first + node.prim_count as usize]);
-                } else {
-                    stack.extend([node.first_index as usize, node.first_index as usize + 1]);
-                }
-            }
-            Slab::around(under.iter().map(|t| t.0), diagonal)
+            let range = &triangles[first as usize..end as usize];
+            Slab::around(area, range.iter().map(|t| t.0), diagonal)
         })
         .collect()
 }
