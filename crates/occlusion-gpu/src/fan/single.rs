@@ -180,23 +180,21 @@ fn single_lane<const BOUNDED: bool>(
             let (hits, enter) = quad_hits::<BOUNDED>(quad, &ray, max_t);
             let mut hits = hits & quad.valid();
             if hits != 0 {
-                // Nearest entry first: the others go on the stack, farthest at the bottom.
+                // Nearest entry first; the others go on the stack in lane order.
                 let enter = enter.to_array();
-                let mut order = [(0.0f32, 0u32); 4];
-                let mut n = 0;
+                let mut near = hits.trailing_zeros() as usize;
+                hits &= hits - 1;
                 while hits != 0 {
                     let lane = hits.trailing_zeros() as usize;
                     hits &= hits - 1;
-                    let mut i = n;
-                    while i > 0 && order[i - 1].0 < enter[lane] {
-                        order[i] = order[i - 1];
-                        i -= 1;
-                    }
-                    order[i] = (enter[lane], quad.entry[lane]);
-                    n += 1;
+                    let far = if enter[lane] < enter[near] {
+                        std::mem::replace(&mut near, lane)
+                    } else {
+                        lane
+                    };
+                    stack.push(quad.entry[far]);
                 }
-                stack.extend(order[..n - 1].iter().map(|&(_, e)| e));
-                entry = order[n - 1].1;
+                entry = quad.entry[near];
                 continue;
             }
         }
