@@ -158,7 +158,21 @@ pub(crate) fn padded_bvh2(
     let mut params = quality;
     params.max_prims_per_leaf = leaf_size;
     let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
-    let mut nodes = bvh.nodes;
+    // Nodes renumbered depth-first, each pair of siblings placed when its parent is reached:
+    // the root at 0, siblings at 2i + 1 and 2i + 2, a subtree's nodes near each other.
+    let mut nodes = Vec::with_capacity(bvh.nodes.len());
+    nodes.push(bvh.nodes[0]);
+    let mut stack = vec![0usize];
+    while let Some(i) = stack.pop() {
+        let node: &obvhs::bvh2::node::Bvh2Node = &nodes[i];
+        if node.prim_count == 0 {
+            let c = node.first_index as usize;
+            let first = nodes.len();
+            nodes.extend([bvh.nodes[c], bvh.nodes[c + 1]]);
+            nodes[i].first_index = first as u32;
+            stack.extend([first + 1, first]);
+        }
+    }
     // The leaves renumbered depth-first (obvhs's PLOC leaves them in build order), so that
     // every subtree's triangles are one range of the leaf order (the fan slabs' bounds).
     let mut order = Vec::with_capacity(bvh.primitive_indices.len());
