@@ -159,7 +159,8 @@ pub(crate) fn padded_bvh2(
     params.max_prims_per_leaf = leaf_size;
     let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
     // Nodes renumbered depth-first, each pair of siblings placed when its parent is reached:
-    // the root at 0, siblings at 2i + 1 and 2i + 2, a subtree's nodes near each other.
+    // the root at 0, every pair of siblings from an odd index, a subtree's nodes near each
+    // other (obvhs leaves them in PLOC's merge order).
     let mut nodes = Vec::with_capacity(bvh.nodes.len());
     nodes.push(bvh.nodes[0]);
     let mut stack = vec![0usize];
