@@ -57,7 +57,7 @@ use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::ray::Ray;
 use rayon::prelude::*;
 
-use crate::fan::{FanTracer, PreparedDirections, RayFan, fan_groups};
+use crate::fan::{FanTracer, Packed, PreparedDirections, RayFan, fan_groups};
 use crate::matrix::WORD_BITS;
 use crate::progress::Ticker;
 use crate::refit::{LeafOrder, padded_bvh2, scene_triangles};
@@ -697,6 +697,7 @@ fn fan_columns(
             let mut out = vec![0u32; rows.len() * words_per_row];
             let mut rays = 0u64;
             let mut facing = Vec::new();
+            let mut packed = Packed::default();
             let mut fan = RayFan::new();
             for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
                 let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
@@ -708,30 +709,18 @@ fn fan_columns(
                     .map(|w| w.count_ones() as usize)
                     .sum::<usize>();
                 rays += n as u64;
-                let count = n.div_ceil(crate::fan::FAN_SIZE);
-                // The facing directions in curve order, cut into `count` runs of 64 (the last
-                // holds the rest): full lane groups in all but one fan.
-                let mut lanes = [0u32; crate::fan::FAN_SIZE];
-                let (mut word, mut bits) = (0usize, facing.first().copied().unwrap_or(0));
-                let mut taken = 0usize;
-                for f in 0..count {
-                    let end = ((f + 1) * crate::fan::FAN_SIZE).min(n);
-                    fan.clear();
-                    while taken < end {
-                        while bits == 0 {
-                            word += 1;
-                            bits = facing[word];
-                        }
-                        let c = word * 64 + bits.trailing_zeros() as usize;
-                        bits &= bits - 1;
-                        lanes[fan.push_prepared(&prepared_dirs, c)] = curve[c];
-                        taken += 1;
-                    }
+                // The facing directions in curve order, cut into runs of 64 (the last holds
+                // the rest): full lane groups in all but one fan.
+                prepared_dirs.compact(&facing, &mut packed);
+                for start in (0..n).step_by(crate::fan::FAN_SIZE) {
+                    let run = start..(start + crate::fan::FAN_SIZE).min(n);
+                    fan.fill(&packed, run);
                     let mut open = tracer.unoccluded(origin, &fan, fan.full_mask(), span.max_t);
                     while open != 0 {
                         let lane = open.trailing_zeros() as usize;
                         open &= open - 1;
-                        let j = columns.start + lanes[lane] as usize;
+                        let c = packed.index[start + lane] as usize;
+                        let j = columns.start + curve[c] as usize;
                         out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
                     }
                 }

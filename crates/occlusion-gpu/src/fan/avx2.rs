@@ -7,15 +7,16 @@
 //! instead of 16 groups of 4, halving the per-group loops.
 
 use std::arch::x86_64::{
-    __m256, _CMP_GE_OS, _CMP_GT_OS, _CMP_LE_OS, _CMP_LT_OS, _mm256_add_ps, _mm256_and_ps,
-    _mm256_andnot_ps, _mm256_cmp_ps, _mm256_max_ps, _mm256_min_ps, _mm256_movemask_ps,
-    _mm256_mul_ps, _mm256_or_ps, _mm256_set1_ps, _mm256_setzero_ps,
+    __m256, __m256i, _CMP_GE_OS, _CMP_GT_OS, _CMP_LE_OS, _CMP_LT_OS, _mm256_add_epi32,
+    _mm256_add_ps, _mm256_and_ps, _mm256_andnot_ps, _mm256_cmp_ps, _mm256_max_ps, _mm256_min_ps,
+    _mm256_movemask_ps, _mm256_mul_ps, _mm256_or_ps, _mm256_permutevar8x32_ps, _mm256_set1_epi32,
+    _mm256_set1_ps, _mm256_setzero_ps,
 };
 
 use glam::{Vec3A, Vec4};
 
 use super::{
-    ALONE, FanNode, FanSetup, FanTracer, FanTriangle, GROUPS, RayFan, Stacks, lanes_alone,
+    ALONE, FanNode, FanSetup, FanTracer, FanTriangle, GROUPS, Packed, RayFan, Stacks, lanes_alone,
 };
 use crate::cpu::EDGE_TOLERANCE;
 
@@ -271,4 +272,48 @@ fn triangle_lanes<const BOUNDED: bool>(
         out |= u64::from(_mm256_movemask_ps(hit) as u8) << (WIDE * g);
     }
     out & mask
+}
+
+/// For each 8-bit mask, the positions of its set bits in order (the rest zero): the
+/// permutation that packs those lanes to the front.
+const PACK: [[u32; 8]; 256] = {
+    let mut table = [[0u32; 8]; 256];
+    let mut mask = 0;
+    while mask < 256 {
+        let (mut bit, mut n) = (0, 0);
+        while bit < 8 {
+            if mask >> bit & 1 == 1 {
+                table[mask][n] = bit as u32;
+                n += 1;
+            }
+            bit += 1;
+        }
+        mask += 1;
+    }
+    table
+};
+
+/// The AVX2 [`super::PreparedDirections::compact`]: per block of eight directions of
+/// `sources` (x, y, z, reciprocals), those whose bit is set in `words` packed to the front by
+/// one permute per coordinate and written eight lanes at a time, the next block's written
+/// from the first lane it did not fill.
+#[target_feature(enable = "avx2")]
+pub(super) fn compact(sources: &[&[f32]; 6], words: &[u64], blocks: usize, out: &mut Packed) {
+    let mut len = 0;
+    for b in 0..blocks {
+        let bits = (words[b / 8] >> (8 * (b % 8))) as u8;
+        if bits == 0 {
+            continue;
+        }
+        let order: __m256i = bytemuck::cast(PACK[usize::from(bits)]);
+        for (lanes, source) in out.lanes.iter_mut().zip(sources) {
+            let block: [f32; 8] = source[8 * b..8 * b + 8].try_into().expect("eight lanes");
+            let packed = _mm256_permutevar8x32_ps(bytemuck::cast(block), order);
+            lanes[len..len + 8].copy_from_slice(&bytemuck::cast::<__m256, [f32; 8]>(packed));
+        }
+        let index = _mm256_add_epi32(order, _mm256_set1_epi32(8 * b as i32));
+        out.index[len..len + 8].copy_from_slice(&bytemuck::cast::<__m256i, [u32; 8]>(index));
+        len += bits.count_ones() as usize;
+    }
+    out.len = len;
 }
