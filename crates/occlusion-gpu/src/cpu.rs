@@ -29,11 +29,12 @@
 //!
 //! [`CpuMethod::Auto`] (the default) takes fans when a call computes at least
 //! [`FAN_MIN_COLUMNS`] columns and packets below. Measured on the full bunny (35,947
-//! vertices, BVH build included, best of 9 runs on 2 threads): packets 31.8 / 55.5 / 151 /
-//! 502 / 1,831 ms at k = 6 / 18 / 66 / 258 / 1026, fans 43.8 / 47.0 / 80.8 / 216 / 633 ms
-//! (before issue #20: fans 427 / 1,171 ms at k = 258 / 1026, and slower than packets up to
-//! k = 18). With few directions a vertex's fan is nearly empty and the per-fan set-up
-//! dominates; with many, the shared origin pays. Same M: at k = 258 no entry of the 9.3 M
+//! vertices, BVH build included, best of 9 runs on 2 threads, one session): packets 43.3 /
+//! 67.9 / 173 / 571 / 2,062 ms at k = 6 / 18 / 66 / 258 / 1026 (best of 5 for the last two),
+//! fans 49.4 / 56.0 / 92.4 / 221 / 614 ms. The fans of issue #20's third session
+//! (c1c5d25), the same day: 55.3 / 253 ms at k = 6 / 258; at the issue's start, an earlier
+//! day: 427 / 1,171 ms at k = 258 / 1026. With few directions a vertex's fan is nearly
+//! empty and the per-fan set-up dominates; with many, the shared origin pays. Same M: at k = 258 no entry of the 9.3 M
 //! differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing rays). A
 //! per-direction uniform grid of the projected triangles was also tried and dropped: its
 //! per-direction fill (∝ triangles × k) cost more than the rays it saved (1.7× slower than
@@ -93,7 +94,7 @@ pub enum CpuMethod {
 }
 
 /// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 6 (packets
-/// 1.38× faster) and k = 18 (fans 1.18× faster).
+/// 1.14× faster) and k = 18 (fans 1.21× faster).
 pub const FAN_MIN_COLUMNS: usize = 12;
 
 impl CpuMethod {

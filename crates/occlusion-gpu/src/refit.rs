@@ -11,9 +11,9 @@
 //! of ~24 ms against a 4 ms build tolerates ~15 % of degradation; a fixed 1.5 cap alone
 //! made refitting 7.5 % slower than rebuilding every frame there, and the SAH ratio alone
 //! (which underestimates the slowdown of the slab-culled fan traversal) 10 % slower. Per frame
-//! (`benches/deforming.rs`, one run, medians): drape k = 258 24.6 ms refitting against
-//! 28.1 ms rebuilding, k = 66 8.9 vs 11.8; the chicken at k = 258 20.6 vs 22.5, k = 66 7.5 vs
-//! 9.4.
+//! (`benches/deforming.rs`, one run, medians): drape k = 258 23.7 ms refitting against
+//! 27.3 ms rebuilding, k = 66 10.1 vs 12.6; the chicken at k = 258 19.8 vs 22.1, k = 66 7.1
+//! vs 9.6.
 
 use std::time::Duration;
 
