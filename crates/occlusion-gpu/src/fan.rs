@@ -151,8 +151,9 @@ fn reciprocal(v: Vec4) -> Vec4 {
     )
 }
 
-/// Directions with their [`reciprocal`]s, ready to be pushed into fans many times
-/// ([`RayFan::push_prepared`]): the lightsphere's, shared by every vertex.
+/// Directions with their [`reciprocal`]s, ready to be packed into fans many times
+/// ([`PreparedDirections::compact`], [`RayFan::fill`]): the lightsphere's, shared by every
+/// vertex.
 pub(crate) struct PreparedDirections {
     /// Directions, four per vector (padded with zeros to a multiple of eight).
     pub(crate) xyz: [Vec<Vec4>; 3],
