@@ -42,8 +42,8 @@ pub(crate) struct LeafOrder {
 impl LeafOrder {
     /// Records the leaf order of freshly built, padded `nodes`.
     pub(crate) fn new(nodes: &[Bvh2Node], order: Vec<u32>) -> Self {
-        // obvhs's PLOC output does not place children after their parents: record an order
-        // once, at build.
+        // Recorded once, at build, from the tree itself (it does not rely on `padded_bvh2`'s
+        // depth-first numbering).
         let mut bottom_up = Vec::with_capacity(nodes.len());
         let mut stack = if nodes.is_empty() { vec![] } else { vec![0u32] };
         while let Some(i) = stack.pop() {
@@ -158,35 +158,26 @@ pub(crate) fn padded_bvh2(
     let mut params = quality;
     params.max_prims_per_leaf = leaf_size;
     let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
-    // Nodes renumbered depth-first, each pair of siblings placed when its parent is reached:
-    // the root at 0, every pair of siblings from an odd index, a subtree's nodes near each
-    // other (obvhs leaves them in PLOC's merge order).
+    // One depth-first walk renumbers the nodes — each pair of siblings placed when its parent
+    // is reached: the root at 0, every pair from an odd index, a subtree's nodes near each
+    // other — and the leaves' triangles, so that every subtree's triangles are one range of
+    // the leaf order (the fan slabs' bounds). obvhs leaves both in PLOC's merge order.
     let mut nodes = Vec::with_capacity(bvh.nodes.len());
     nodes.push(bvh.nodes[0]);
-    let mut stack = vec![0usize];
-    while let Some(i) = stack.pop() {
-        let node: &obvhs::bvh2::node::Bvh2Node = &nodes[i];
-        if node.prim_count == 0 {
-            let c = node.first_index as usize;
-            let first = nodes.len();
-            nodes.extend([bvh.nodes[c], bvh.nodes[c + 1]]);
-            nodes[i].first_index = first as u32;
-            stack.extend([first + 1, first]);
-        }
-    }
-    // The leaves renumbered depth-first (obvhs's PLOC leaves them in build order), so that
-    // every subtree's triangles are one range of the leaf order (the fan slabs' bounds).
     let mut order = Vec::with_capacity(bvh.primitive_indices.len());
     let mut stack = vec![0usize];
     while let Some(i) = stack.pop() {
-        let node = &mut nodes[i];
+        let at = nodes.len();
+        let node: &mut obvhs::bvh2::node::Bvh2Node = &mut nodes[i];
+        let first = node.first_index as usize;
         if node.prim_count > 0 {
-            let first = node.first_index as usize;
             node.first_index = order.len() as u32;
             order
                 .extend_from_slice(&bvh.primitive_indices[first..first + node.prim_count as usize]);
         } else {
-            stack.extend([node.first_index as usize + 1, node.first_index as usize]);
+            node.first_index = at as u32;
+            nodes.extend([bvh.nodes[first], bvh.nodes[first + 1]]);
+            stack.extend([at + 1, at]);
         }
     }
     let ordered = order.iter().map(|&i| tris[i as usize]).collect();
