@@ -29,13 +29,15 @@
 //!
 //! [`CpuMethod::Auto`] (the default) takes fans when a call computes at least
 //! [`FAN_MIN_COLUMNS`] columns and packets below. Measured on the full bunny (35,947
-//! vertices, BVH build included, best of 9 runs on 2 threads, one session): packets 43.3 /
-//! 67.9 / 173 / 571 / 2,062 ms at k = 6 / 18 / 66 / 258 / 1026 (best of 5 for the last two),
-//! fans 49.4 / 56.0 / 92.4 / 221 / 614 ms. The fans of issue #20's third session
-//! (c1c5d25), the same day: 55.3 / 253 ms at k = 6 / 258; at the issue's start, an earlier
-//! day: 427 / 1,171 ms at k = 258 / 1026. With few directions a vertex's fan is nearly
-//! empty and the per-fan set-up dominates; with many, the shared origin pays. Same M: at k = 258 no entry of the 9.3 M
-//! differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing rays). A
+//! vertices, BVH build included — each method's own `obvhs` preset, [`packet_build`] and
+//! [`fan_build`] — on 2 threads, one session, best of 9 runs; of 5 at k = 258, of 5 / 3 at
+//! k = 1026): packets 34.5 / 63.3 / 163 / 604 / 2,305 ms at k = 6 / 18 / 66 / 258 / 1026,
+//! fans 43.6 / 52.8 / 91.6 / 226 / 681 ms. (An earlier session, its day: packets 43.3 / 67.9
+//! / 173 / 571 / 2,062, fans 49.4 / 56.0 / 92.4 / 221 / 614; at the issue's start: fans 427
+//! / 1,171 ms at k = 258 / 1026.) With few directions a vertex's fan is nearly empty and the
+//! per-fan set-up dominates; with many, the shared origin pays. Same M: at k = 258 no entry
+//! of the 9.3 M differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing
+//! rays); neither changes with the build preset (M's hash checked). A
 //! per-direction uniform grid of the projected triangles was also tried and dropped: its
 //! per-direction fill (∝ triangles × k) cost more than the rays it saved (1.7× slower than
 //! single rays).
@@ -76,6 +78,26 @@ pub const DEFAULT_OFFSET_RELATIVE: f32 = 1e-4;
 /// 1e-6 of an edge.
 pub(crate) const EDGE_TOLERANCE: f32 = 1e-6;
 
+/// `obvhs`'s build settings for the fans' tree: `fast_build` (PLOC over a short search
+/// distance, 2 % reinsertion). Against `medium_build`, same day, BVH build included (A/B
+/// medians of 5 alternated runs, best of 3 each): bunny k = 18 / 66 / 258 / 1026 0.95 /
+/// 0.97 / 0.97 / 0.98× the time, igea and dragon at k = 258 0.96 / 0.97× — the build's
+/// saving (bunny 28 → 24 ms, igea 143 → 120, dragon 112 → 89) outweighs the slightly worse
+/// tree. `very_fast_build` against `fast_build`: igea 0.94×, but the dragon 1.07× (its build
+/// 89 → 80 ms, its trace slower) and the bunny at k = 1026 1.01–1.02×; `slow_build` (spatial
+/// splits) was 1.06–1.15× `medium_build`'s time.
+fn fan_build() -> BvhBuildParams {
+    BvhBuildParams::fast_build()
+}
+
+/// `obvhs`'s build settings for the packets' tree (calls of under [`FAN_MIN_COLUMNS`]
+/// columns, where the build is most of the time): `very_fast_build`. Bunny, same day, A/B
+/// medians of 7: 0.85× `medium_build`'s time at k = 6 and 0.89× at k = 18; 0.94× `fast_build`'s
+/// at k = 6.
+fn packet_build() -> BvhBuildParams {
+    BvhBuildParams::very_fast_build()
+}
+
 /// How the `cpu` backend traverses its BVH. All are exact and give the same M (up to rays
 /// within rounding of a triangle edge).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -94,7 +116,7 @@ pub enum CpuMethod {
 }
 
 /// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 6 (packets
-/// 1.14× faster) and k = 18 (fans 1.21× faster).
+/// 1.26× faster) and k = 18 (fans 1.20× faster).
 pub const FAN_MIN_COLUMNS: usize = 12;
 
 impl CpuMethod {
@@ -374,9 +396,7 @@ impl Tracer {
                 TracerKind::Packets(PacketTracer::new(prepared))
             }
             CpuMethod::SingleRays => TracerKind::SingleRays(CpuTracer::new(prepared)),
-            CpuMethod::Fans => {
-                TracerKind::Fans(FanTracer::new(prepared, BvhBuildParams::medium_build()))
-            }
+            CpuMethod::Fans => TracerKind::Fans(FanTracer::new(prepared, fan_build())),
         };
         Self {
             positions: prepared.positions.clone(),
@@ -433,8 +453,7 @@ struct PacketTracer {
 
 impl PacketTracer {
     fn new(prepared: &Prepared) -> Self {
-        let (nodes, tris, leaves) =
-            padded_bvh2(prepared, BvhBuildParams::medium_build(), PACKET_LEAF_SIZE);
+        let (nodes, tris, leaves) = padded_bvh2(prepared, packet_build(), PACKET_LEAF_SIZE);
         let triangles = tris
             .iter()
             .map(|t| EdgeTriangle::new([t.v0.into(), t.v1.into(), t.v2.into()]))
