@@ -459,24 +459,17 @@ fn bvh_columns(
     span: RaySpan,
     target: ColumnsTarget<'_>,
 ) -> u64 {
-    let ColumnsTarget {
-        bits,
-        words_per_row,
-        ticker,
-    } = target;
-    let order = morton_order(prepared);
-    let chunks: Vec<(Vec<u32>, u64)> = order
-        .par_chunks(ROWS_PER_CHUNK)
-        .map(|rows| {
+    let words_per_row = target.words_per_row;
+    in_chunks(
+        prepared,
+        ROWS_PER_CHUNK,
+        columns.clone(),
+        target,
+        |rows, out| {
             let mut cache = vec![NO_TRIANGLE; dirs.len()];
-            let mut out = vec![0u32; rows.len() * words_per_row];
             let mut rays = 0u64;
-            let origins: Vec<Option<(Vec3A, Vec3A)>> = rows
-                .iter()
-                .map(|&row| ray_origin(prepared, row as usize, span.offset))
-                .collect();
-            for (origin, out_row) in origins.iter().zip(out.chunks_exact_mut(words_per_row)) {
-                let Some((origin, normal)) = *origin else {
+            for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
+                let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
                     continue;
                 };
                 for j in columns.clone() {
@@ -490,11 +483,9 @@ fn bvh_columns(
                     }
                 }
             }
-            ticker.tick((rows.len() * columns.len()) as u64);
-            (out, rays)
-        })
-        .collect();
-    scatter_chunks(&order, ROWS_PER_CHUNK, chunks, columns, bits, words_per_row)
+            rays
+        },
+    )
 }
 
 /// [`compute_columns`] with fans ([`CpuMethod::Fans`]): the columns' directions ordered
@@ -509,11 +500,7 @@ fn fan_columns(
     span: RaySpan,
     target: ColumnsTarget<'_>,
 ) -> u64 {
-    let ColumnsTarget {
-        bits,
-        words_per_row,
-        ticker,
-    } = target;
+    let words_per_row = target.words_per_row;
     let dirs = &directions[columns.clone()];
     // The directions in the order of their recursive median split (`fan_groups`): neighbours
     // in this order are neighbours on the sphere.
@@ -524,11 +511,12 @@ fn fan_columns(
         .collect();
     let curve_dirs: Vec<Vec3> = curve.iter().map(|&i| dirs[i as usize]).collect();
     let prepared_dirs = PreparedDirections::new(&curve_dirs);
-    let order = morton_order(prepared);
-    let chunks: Vec<(Vec<u32>, u64)> = order
-        .par_chunks(ROWS_PER_CHUNK)
-        .map(|rows| {
-            let mut out = vec![0u32; rows.len() * words_per_row];
+    in_chunks(
+        prepared,
+        ROWS_PER_CHUNK,
+        columns.clone(),
+        target,
+        |rows, out| {
             let mut rays = 0u64;
             let mut facing = Vec::new();
             let mut packed = Packed::default();
@@ -543,8 +531,8 @@ fn fan_columns(
                     .map(|w| w.count_ones() as usize)
                     .sum::<usize>();
                 rays += n as u64;
-                // The facing directions in curve order, cut into runs of 64 (the last holds
-                // the rest): full lane groups in all but one fan.
+                // The facing directions in curve order, cut into runs of 64 (the last holds the
+                // rest): full lane groups in all but one fan.
                 prepared_dirs.compact(&facing, &mut packed);
                 for start in (0..n).step_by(crate::fan::FAN_SIZE) {
                     let run = start..(start + crate::fan::FAN_SIZE).min(n);
@@ -559,11 +547,38 @@ fn fan_columns(
                     }
                 }
             }
+            rays
+        },
+    )
+}
+
+/// The rows of `prepared` in Morton order, `chunk_rows` per rayon task: `chunk(rows, out)`
+/// sets the bits of `columns` in `out` (`rows`' rows of M, zeroed, `target.words_per_row`
+/// words each) and returns the rays it cast; each finished chunk is counted on
+/// `target.ticker` and copied into `target.bits`. Returns the rays cast.
+fn in_chunks(
+    prepared: &Prepared,
+    chunk_rows: usize,
+    columns: Range<usize>,
+    target: ColumnsTarget<'_>,
+    chunk: impl Fn(&[u32], &mut [u32]) -> u64 + Sync,
+) -> u64 {
+    let ColumnsTarget {
+        bits,
+        words_per_row,
+        ticker,
+    } = target;
+    let order = morton_order(prepared);
+    let chunks: Vec<(Vec<u32>, u64)> = order
+        .par_chunks(chunk_rows)
+        .map(|rows| {
+            let mut out = vec![0u32; rows.len() * words_per_row];
+            let rays = chunk(rows, &mut out);
             ticker.tick((rows.len() * columns.len()) as u64);
             (out, rays)
         })
         .collect();
-    scatter_chunks(&order, ROWS_PER_CHUNK, chunks, columns, bits, words_per_row)
+    scatter_chunks(&order, chunk_rows, chunks, columns, bits, words_per_row)
 }
 
 /// Copies the columns `columns` of per-chunk row blocks (rows `order` in chunks of

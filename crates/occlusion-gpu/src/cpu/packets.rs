@@ -7,9 +7,8 @@ use std::ops::Range;
 
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
-use rayon::prelude::*;
 
-use super::{ColumnsTarget, EdgeTriangle, RaySpan, morton_order, ray_origin, scatter_chunks};
+use super::{ColumnsTarget, EdgeTriangle, RaySpan, in_chunks, ray_origin};
 use crate::matrix::WORD_BITS;
 use crate::refit::{LeafOrder, padded_bvh2};
 use crate::scene::Prepared;
@@ -163,44 +162,33 @@ pub(super) fn packet_columns(
     span: RaySpan,
     target: ColumnsTarget<'_>,
 ) -> u64 {
-    let ColumnsTarget {
-        bits,
-        words_per_row,
-        ticker,
-    } = target;
-    let order = morton_order(prepared);
-    let chunks: Vec<(Vec<u32>, u64)> = order
-        .par_chunks(PACKET)
-        .map(|rows| {
-            let mut out = vec![0u32; rows.len() * words_per_row];
-            let mut origins = [Vec3A::ZERO; PACKET];
-            let mut normals = [Vec3A::ZERO; PACKET];
-            for (r, &row) in rows.iter().enumerate() {
-                if let Some((o, n)) = ray_origin(prepared, row as usize, span.offset) {
-                    origins[r] = o;
-                    normals[r] = n;
+    let words_per_row = target.words_per_row;
+    in_chunks(prepared, PACKET, columns.clone(), target, |rows, out| {
+        let mut origins = [Vec3A::ZERO; PACKET];
+        let mut normals = [Vec3A::ZERO; PACKET];
+        for (r, &row) in rows.iter().enumerate() {
+            if let Some((o, n)) = ray_origin(prepared, row as usize, span.offset) {
+                origins[r] = o;
+                normals[r] = n;
+            }
+        }
+        let mut rays = 0u64;
+        for j in columns.clone() {
+            let direction = dirs[j];
+            let mut mask = 0u64;
+            for (r, normal) in normals[..rows.len()].iter().enumerate() {
+                if normal.dot(direction) > 0.0 {
+                    mask |= 1 << r;
                 }
             }
-            let mut rays = 0u64;
-            for j in columns.clone() {
-                let direction = dirs[j];
-                let mut mask = 0u64;
-                for (r, normal) in normals[..rows.len()].iter().enumerate() {
-                    if normal.dot(direction) > 0.0 {
-                        mask |= 1 << r;
-                    }
-                }
-                rays += u64::from(mask.count_ones());
-                let mut visible = tracer.unoccluded(&origins, direction, mask, span.max_t);
-                while visible != 0 {
-                    let r = visible.trailing_zeros() as usize;
-                    visible &= visible - 1;
-                    out[r * words_per_row + j / WORD_BITS] |= 1 << (j % WORD_BITS);
-                }
+            rays += u64::from(mask.count_ones());
+            let mut visible = tracer.unoccluded(&origins, direction, mask, span.max_t);
+            while visible != 0 {
+                let r = visible.trailing_zeros() as usize;
+                visible &= visible - 1;
+                out[r * words_per_row + j / WORD_BITS] |= 1 << (j % WORD_BITS);
             }
-            ticker.tick((rows.len() * columns.len()) as u64);
-            (out, rays)
-        })
-        .collect();
-    scatter_chunks(&order, PACKET, chunks, columns, bits, words_per_row)
+        }
+        rays
+    })
 }
