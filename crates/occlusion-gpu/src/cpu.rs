@@ -37,10 +37,19 @@
 //! / 1,171 ms at k = 258 / 1026.) With few directions a vertex's fan is nearly empty and the
 //! per-fan set-up dominates; with many, the shared origin pays. Same M: at k = 258 no entry
 //! of the 9.3 M differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing
-//! rays); neither changes with the build preset (M's hash checked). A
-//! per-direction uniform grid of the projected triangles was also tried and dropped: its
-//! per-direction fill (∝ triangles × k) cost more than the rays it saved (1.7× slower than
-//! single rays).
+//! rays); neither changes with the build preset (M's hash checked).
+//!
+//! A per-direction uniform grid of the projected triangles (the rays of one direction are
+//! parallel: project every vertex onto the plane across l_j, bin each triangle's 2D box into
+//! cells, test each origin against its cell's list in 2D) was tried twice and dropped. First
+//! against single rays (1.7× slower). Then against fans, with a correct prototype (1 bit of M
+//! in 9.3 M apart from the fans', an edge-grazing ray): bunny k = 258 on 2 threads, best of
+//! 3, 0.84–1.12 s (the best at 0.25 cells per triangle) against the fans' 0.20 s, over cell
+//! sizes of 0.1–2 cells per triangle. At 1 cell per triangle, 8.5 list entries per triangle
+//! and direction and 18 triangle tests per ray: the fill alone took 1.0–1.1 s of CPU time,
+//! 2.7× the fans' whole call on one thread (0.38 s), and it grows with triangles × k
+//! whatever the rays. Bigger cells trade entries for tests (0.1 cells per triangle: 2.6
+//! entries, 48 tests per ray, 1.08 s).
 //!
 //! BVH crate: `obvhs` 0.4 over `bvh` 0.13. `bvh` is a binary BVH on nalgebra whose
 //! traversal collects candidate shapes per ray; `obvhs` builds BVHs by PLOC with reinsertion

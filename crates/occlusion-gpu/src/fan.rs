@@ -67,7 +67,13 @@
 //! visits repeat one of the same vertex's, but the work is in the lane groups, not the
 //! visits); sixteen-lane AVX-512 groups (3 % slower: emptier groups); a cone-against-box
 //! cull of the whole fan (would skip 8 % of the groups it costs); lone walks eight boxes per
-//! step (AVX2, three levels: −2 % at k = 258, +1–3 % at k = 1026).
+//! step (AVX2, three levels: −2 % at k = 258, +1–3 % at k = 1026); the lane groups stepping
+//! through the [`Quad`]s as the lone walks do, four grandchildren per pop (half the pops,
+//! same M: 3–5 % slower at bunny k = 258 and 1026 and igea k = 258 — a child's cull narrows
+//! the lanes its two children are tested with, worth more than the pops it costs); a call's
+//! lone walks (two to four lanes in 67 % of the 926 k calls at bunny k = 258) advanced a
+//! step each in turn, to overlap one's quad loads with another's arithmetic (5 % slower,
+//! A/B median of 5).
 
 use glam::{BVec3A, BVec4A, Mat3, Vec3, Vec3A, Vec4};
 use obvhs::BvhBuildParams;
