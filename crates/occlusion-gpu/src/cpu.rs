@@ -368,10 +368,16 @@ pub(crate) fn compute_columns(
         max_t: params.max_distance,
     };
     let dirs: Vec<Vec3A> = directions.iter().map(|&d| d.into()).collect();
+    let call = ColumnsCall {
+        prepared,
+        columns,
+        span,
+        target,
+    };
     match &tracer.kind {
-        TracerKind::Packets(t) => packet_columns(prepared, t, &dirs, columns, span, target),
-        TracerKind::Fans(t) => fan_columns(prepared, t, directions, columns, span, target),
-        TracerKind::SingleRays(t) => bvh_columns(prepared, t, &dirs, columns, span, target),
+        TracerKind::Packets(t) => packet_columns(t, &dirs, call),
+        TracerKind::Fans(t) => fan_columns(t, directions, call),
+        TracerKind::SingleRays(t) => bvh_columns(t, &dirs, call),
     }
 }
 
@@ -383,6 +389,15 @@ pub(crate) struct ColumnsTarget<'a> {
     pub(crate) words_per_row: usize,
     /// Counts the cells of finished chunks of rows.
     pub(crate) ticker: &'a Ticker,
+}
+
+/// One [`compute_columns`] call as each traversal's chunks see it: the scene, the columns
+/// to fill, where the rays start and end, and where the bits go.
+struct ColumnsCall<'a> {
+    prepared: &'a Prepared,
+    columns: Range<usize>,
+    span: RaySpan,
+    target: ColumnsTarget<'a>,
 }
 
 /// Where every ray of a call starts and ends: origins pushed `offset` along the normal, hits
@@ -475,56 +490,38 @@ const ROWS_PER_CHUNK: usize = 64;
 /// triangle is tested before the BVH is traversed. The result is exactly that of a plain
 /// traversal: a cached triangle that is hit is a hit the traversal would also report (the
 /// any-hit query has no closest-hit order), and a miss falls through to the traversal.
-fn bvh_columns(
-    prepared: &Prepared,
-    tracer: &CpuTracer,
-    dirs: &[Vec3A],
-    columns: Range<usize>,
-    span: RaySpan,
-    target: ColumnsTarget<'_>,
-) -> u64 {
-    let words_per_row = target.words_per_row;
-    in_chunks(
-        prepared,
-        ROWS_PER_CHUNK,
-        columns.clone(),
-        target,
-        |rows, out| {
-            let mut cache = vec![NO_TRIANGLE; dirs.len()];
-            let mut rays = 0u64;
-            for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
-                let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
+fn bvh_columns(tracer: &CpuTracer, dirs: &[Vec3A], call: ColumnsCall<'_>) -> u64 {
+    let (prepared, span, columns) = (call.prepared, call.span, call.columns.clone());
+    let words_per_row = call.target.words_per_row;
+    in_chunks(call, ROWS_PER_CHUNK, |rows, out| {
+        let mut cache = vec![NO_TRIANGLE; dirs.len()];
+        let mut rays = 0u64;
+        for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
+            let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
+                continue;
+            };
+            for j in columns.clone() {
+                let direction = dirs[j];
+                if normal.dot(direction) <= 0.0 {
                     continue;
-                };
-                for j in columns.clone() {
-                    let direction = dirs[j];
-                    if normal.dot(direction) <= 0.0 {
-                        continue;
-                    }
-                    rays += 1;
-                    if tracer.unoccluded_cached(origin, direction, span.max_t, &mut cache[j]) {
-                        out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
-                    }
+                }
+                rays += 1;
+                if tracer.unoccluded_cached(origin, direction, span.max_t, &mut cache[j]) {
+                    out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
                 }
             }
-            rays
-        },
-    )
+        }
+        rays
+    })
 }
 
 /// [`compute_columns`] with fans ([`CpuMethod::Fans`]): the columns' directions ordered
 /// once along [`fan_groups`]' split; every vertex takes those above its tangent plane in that
 /// order and traces them from its origin in runs of 64 (the last shorter), one fan each; rows in
 /// Morton order, [`ROWS_PER_CHUNK`] per task.
-fn fan_columns(
-    prepared: &Prepared,
-    tracer: &FanTracer,
-    directions: &[Vec3],
-    columns: Range<usize>,
-    span: RaySpan,
-    target: ColumnsTarget<'_>,
-) -> u64 {
-    let words_per_row = target.words_per_row;
+fn fan_columns(tracer: &FanTracer, directions: &[Vec3], call: ColumnsCall<'_>) -> u64 {
+    let (prepared, span, columns) = (call.prepared, call.span, call.columns.clone());
+    let words_per_row = call.target.words_per_row;
     let dirs = &directions[columns.clone()];
     // The directions in the order of their recursive median split (`fan_groups`): neighbours
     // in this order are neighbours on the sphere.
@@ -535,63 +532,62 @@ fn fan_columns(
         .collect();
     let curve_dirs: Vec<Vec3> = curve.iter().map(|&i| dirs[i as usize]).collect();
     let prepared_dirs = PreparedDirections::new(&curve_dirs);
-    in_chunks(
-        prepared,
-        ROWS_PER_CHUNK,
-        columns.clone(),
-        target,
-        |rows, out| {
-            let mut rays = 0u64;
-            let mut facing = Vec::new();
-            let mut packed = Packed::default();
-            let mut fan = RayFan::new();
-            for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
-                let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
-                    continue;
-                };
-                prepared_dirs.facing(normal.into(), &mut facing);
-                let n = facing
-                    .iter()
-                    .map(|w| w.count_ones() as usize)
-                    .sum::<usize>();
-                rays += n as u64;
-                // The facing directions in curve order, cut into runs of 64 (the last holds the
-                // rest): full lane groups in all but one fan.
-                prepared_dirs.compact(&facing, &mut packed);
-                for start in (0..n).step_by(crate::fan::FAN_SIZE) {
-                    let run = start..(start + crate::fan::FAN_SIZE).min(n);
-                    fan.fill(&packed, run);
-                    let mut open = tracer.unoccluded(origin, &fan, fan.full_mask(), span.max_t);
-                    while open != 0 {
-                        let lane = open.trailing_zeros() as usize;
-                        open &= open - 1;
-                        let c = packed.index[start + lane] as usize;
-                        let j = columns.start + curve[c] as usize;
-                        out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
-                    }
+    in_chunks(call, ROWS_PER_CHUNK, |rows, out| {
+        let mut rays = 0u64;
+        let mut facing = Vec::new();
+        let mut packed = Packed::default();
+        let mut fan = RayFan::new();
+        for (&row, out_row) in rows.iter().zip(out.chunks_exact_mut(words_per_row)) {
+            let Some((origin, normal)) = ray_origin(prepared, row as usize, span.offset) else {
+                continue;
+            };
+            prepared_dirs.facing(normal.into(), &mut facing);
+            let n = facing
+                .iter()
+                .map(|w| w.count_ones() as usize)
+                .sum::<usize>();
+            rays += n as u64;
+            // The facing directions in curve order, cut into runs of 64 (the last holds the
+            // rest): full lane groups in all but one fan.
+            prepared_dirs.compact(&facing, &mut packed);
+            for start in (0..n).step_by(crate::fan::FAN_SIZE) {
+                let run = start..(start + crate::fan::FAN_SIZE).min(n);
+                fan.fill(&packed, run);
+                let mut open = tracer.unoccluded(origin, &fan, fan.full_mask(), span.max_t);
+                while open != 0 {
+                    let lane = open.trailing_zeros() as usize;
+                    open &= open - 1;
+                    let c = packed.index[start + lane] as usize;
+                    let j = columns.start + curve[c] as usize;
+                    out_row[j / WORD_BITS] |= 1 << (j % WORD_BITS);
                 }
             }
-            rays
-        },
-    )
+        }
+        rays
+    })
 }
 
-/// The rows of `prepared` in Morton order, `chunk_rows` per rayon task: `chunk(rows, out)`
-/// sets the bits of `columns` in `out` (`rows`' rows of M, zeroed, `target.words_per_row`
-/// words each) and returns the rays it cast; each finished chunk is counted on
-/// `target.ticker` and copied into `target.bits`. Returns the rays cast.
+/// The rows of `call.prepared` in Morton order, `chunk_rows` per rayon task:
+/// `chunk(rows, out)` sets the bits of `call.columns` in `out` (`rows`' rows of M, zeroed,
+/// `call.target.words_per_row` words each) and returns the rays it cast; each finished chunk
+/// is counted on `call.target.ticker` and copied into `call.target.bits`. Returns the rays
+/// cast.
 fn in_chunks(
-    prepared: &Prepared,
+    call: ColumnsCall<'_>,
     chunk_rows: usize,
-    columns: Range<usize>,
-    target: ColumnsTarget<'_>,
     chunk: impl Fn(&[u32], &mut [u32]) -> u64 + Sync,
 ) -> u64 {
-    let ColumnsTarget {
-        bits,
-        words_per_row,
-        ticker,
-    } = target;
+    let ColumnsCall {
+        prepared,
+        columns,
+        target:
+            ColumnsTarget {
+                bits,
+                words_per_row,
+                ticker,
+            },
+        ..
+    } = call;
     let order = morton_order(prepared);
     let chunks: Vec<(Vec<u32>, u64)> = order
         .par_chunks(chunk_rows)

@@ -3,12 +3,10 @@
 //! close together, so they walk a binary BVH together, up to 64 at a time (see the parent
 //! module).
 
-use std::ops::Range;
-
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 
-use super::{ColumnsTarget, EdgeTriangle, RaySpan, in_chunks, ray_origin};
+use super::{ColumnsCall, EdgeTriangle, in_chunks, ray_origin};
 use crate::matrix::WORD_BITS;
 use crate::refit::{LeafOrder, padded_bvh2};
 use crate::scene::Prepared;
@@ -154,16 +152,10 @@ const PACKET_LEAF_SIZE: u32 = 2;
 /// [`compute_columns`](super::compute_columns) with packets
 /// ([`CpuMethod::Packets`](super::CpuMethod::Packets)): rows in Morton order, one
 /// packet per chunk of [`PACKET`] rows and direction.
-pub(super) fn packet_columns(
-    prepared: &Prepared,
-    tracer: &PacketTracer,
-    dirs: &[Vec3A],
-    columns: Range<usize>,
-    span: RaySpan,
-    target: ColumnsTarget<'_>,
-) -> u64 {
-    let words_per_row = target.words_per_row;
-    in_chunks(prepared, PACKET, columns.clone(), target, |rows, out| {
+pub(super) fn packet_columns(tracer: &PacketTracer, dirs: &[Vec3A], call: ColumnsCall<'_>) -> u64 {
+    let (prepared, span, columns) = (call.prepared, call.span, call.columns.clone());
+    let words_per_row = call.target.words_per_row;
+    in_chunks(call, PACKET, |rows, out| {
         let mut origins = [Vec3A::ZERO; PACKET];
         let mut normals = [Vec3A::ZERO; PACKET];
         for (r, &row) in rows.iter().enumerate() {
