@@ -6,6 +6,15 @@
 //! own, four boxes at a time: every internal node carries a [`Quad`], its grandchildren's
 //! boxes and slabs lane by lane (a child that is a leaf stands in for its two), so one SIMD
 //! pass tests two levels of the binary tree.
+//!
+//! Where their time goes (bunny, k = 258, the time-stamp counter read around each call and
+//! around each fan's whole traversal): the walks take 45 % of the traversal (38 % at
+//! k = 1026). 926 k calls walk 2.09 M lanes, each through 2.1 quads, 0.43 leaves and 2.0
+//! triangles on average, about 210 counter ticks a walk: most end at their first or second
+//! quad, every box and slab missed. Prefetching a subtree's first quad (three lines) when the
+//! lane groups push it with [`ALONE`] lanes or fewer made the call 6 % slower (A/B median of
+//! 5), so these short walks are not bound by that load alone, whatever the profile's hottest
+//! instruction (the first quad's load) suggests.
 
 use glam::{BVec4A, Vec3A, Vec4};
 
