@@ -78,8 +78,9 @@
 //! trace that half of Mitsuba's time needs. The scene's convex hull (3,124 faces) proves
 //! 5.6 % of the facing rays free before any traversal (numpy prototype, 3,000 of the bunny's
 //! vertices, 258 directions); the rest leave the hull within 0.004 / 0.01 / 0.02 × the
-//! diagonal in 15 / 25 / 34 % of cases, but a ray cut at 0.004 × the diagonal already costs
-//! 0.37–0.39 of a whole one (above): worth at most about 6 % before the hull's own test.
+//! diagonal in 15 / 25 / 34 % of cases, but rays cut at 0.004 × the diagonal already cost,
+//! on average, 0.37–0.39 of whole ones (above): worth at most about 6 % before the hull's
+//! own test.
 //!
 //! BVH crate: `obvhs` 0.4 over `bvh` 0.13. `bvh` is a binary BVH on nalgebra whose
 //! traversal collects candidate shapes per ray; `obvhs` builds BVHs by PLOC with reinsertion
