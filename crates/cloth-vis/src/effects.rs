@@ -47,32 +47,6 @@ impl Effect {
             Effect::Translucency => "translucency",
         }
     }
-
-    /// Whether this build contains the effect's stage. Effects that are not built yet are
-    /// rejected when a scene is validated, before any work starts.
-    pub fn is_built(self) -> bool {
-        matches!(
-            self,
-            Effect::Lighting
-                | Effect::SelfShadowing
-                | Effect::StaticShadowing
-                | Effect::Btf
-                | Effect::ShadowVolumes
-                | Effect::Translucency
-        )
-    }
-
-    /// The crate that will provide an effect that is not built yet.
-    pub fn provider(self) -> &'static str {
-        match self {
-            Effect::Lighting => "cloth-vis + lightsphere",
-            Effect::SelfShadowing => "occlusion-gpu",
-            Effect::StaticShadowing => "hemicube",
-            Effect::Btf => "btf",
-            Effect::ShadowVolumes => "shadows",
-            Effect::Translucency => "translucency",
-        }
-    }
 }
 
 impl fmt::Display for Effect {

@@ -13,19 +13,6 @@ pub enum Error {
         /// What is wrong, with the key and value.
         message: String,
     },
-    /// The scene asks for an effect this build does not contain yet.
-    #[error(
-        "scene {origin}: effect \"{effect}\" is not built yet (it arrives with the `{provider}` \
-         crate); remove it from `effects` to render without it"
-    )]
-    EffectNotBuilt {
-        /// Scene file.
-        origin: String,
-        /// The effect's scene-file name.
-        effect: &'static str,
-        /// The crate that will provide it.
-        provider: &'static str,
-    },
     /// A command's request cannot be carried out (bad option value for this input).
     #[error("{path}: {message}")]
     Request {

@@ -93,7 +93,7 @@ impl Plan {
     /// Validate the scene and plan its stages. Nothing is loaded or computed.
     ///
     /// # Errors
-    /// Every error of [`Scene::validate`]: unknown or unbuilt effects, bad values, missing files.
+    /// Every error of [`Scene::validate`]: unknown effects, bad values, missing files.
     pub fn for_scene(scene: &Scene) -> Result<Self, Error> {
         let effects = scene.validate()?;
         let mut stages = vec![Stage::Geometry, Stage::Render];

@@ -444,20 +444,13 @@ impl Scene {
             .transpose()
     }
 
-    /// Check everything that can be checked without doing the work: effect names and
-    /// availability, value ranges, and that every named file exists.
+    /// Check everything that can be checked without doing the work: effect names, value
+    /// ranges, and that every named file exists.
     ///
     /// # Errors
     /// The first problem found, naming the scene, the key and the value.
     pub fn validate(&self) -> Result<Vec<Effect>, Error> {
         let effects = self.requested_effects()?;
-        if let Some(missing) = effects.iter().find(|e| !e.is_built()) {
-            return Err(Error::EffectNotBuilt {
-                origin: self.origin.clone(),
-                effect: missing.name(),
-                provider: missing.provider(),
-            });
-        }
         if self.objects.is_empty() {
             return Err(self.invalid(
                 "object",
