@@ -25,7 +25,8 @@
 //! only permutes the I_j.
 //!
 //! Outputs by extension:
-//! - `.npy`: a_i as f32 `[N]` (`[F, N]` for several frames), or M as `[N, k]` / `[F, N, k]`;
+//! - `.npy`: a_i as f32 `[N]` (`[F, N]` for several frames; NaN for vertices no triangle
+//!   uses, as in `.ply`), or M as `[N, k]` / `[F, N, k]` (rows of unused vertices 0);
 //! - `.ply` (one frame): positions, normals, gamma-encoded 8-bit colour, float `ao` = a_i (NaN
 //!   for unused vertices);
 //! - `.glb` (one frame, [`meshio::write_glb`]): positions, normals (+Y for unused vertices,
@@ -144,6 +145,9 @@ pub struct VisibilitySummary {
     pub directions: usize,
     /// Vertices per frame N.
     pub vertices: usize,
+    /// Vertices without a normal in the last frame — used by no triangle, or only by
+    /// degenerate ones: a_i is NaN for them (−1 in `.glb`), their rows of M 0.
+    pub unused: usize,
     /// Frames computed.
     pub frames: usize,
     /// Time of the visibility computation alone, all frames (ms).
@@ -153,15 +157,28 @@ pub struct VisibilitySummary {
 }
 
 impl VisibilitySummary {
-    /// The one summary line: `visibility: K directions x N vertices in T ms (BACKEND)`.
+    /// The one summary line: `visibility: K directions x N vertices in T ms (BACKEND)`, and
+    /// where some vertices have no normal, how many (their a_i is NaN).
     pub fn line(&self) -> String {
         let frames = if self.frames > 1 {
             format!(" x {} frames", self.frames)
         } else {
             String::new()
         };
+        let unused = if self.unused > 0 {
+            let (n, noun) = match self.unused {
+                1 => (1, "vertex"),
+                n => (n, "vertices"),
+            };
+            format!(
+                "; {n} {noun} without a normal (no triangle, or only degenerate ones, uses them): \
+                 a_i = NaN (-1 in .glb)"
+            )
+        } else {
+            String::new()
+        };
         format!(
-            "visibility: {} directions x {} vertices{frames} in {:.1} ms ({})",
+            "visibility: {} directions x {} vertices{frames} in {:.1} ms ({}){unused}",
             self.directions,
             self.vertices,
             self.millis,
@@ -525,6 +542,7 @@ pub fn run_visibility(
     Ok(VisibilitySummary {
         directions: k,
         vertices: n,
+        unused: last_ambient.iter().filter(|a| a.is_nan()).count(),
         frames: count,
         millis,
         backend: stage.backend(),
@@ -657,9 +675,11 @@ pub struct VisibilityArgs {
     depth_res: u32,
     #[command(flatten)]
     environment: super::env_args::EnvironmentArgs,
-    /// Output: .npy (a_i as f32 [N] or [F, N]; M as [N, k] or [F, N, k] with --matrix),
-    /// .ply (one frame: colour, float `ao` = a_i, NaN for unused vertices) or .glb (one
-    /// frame: linear float COLOR_0, float `_AO` = a_i, -1 for unused vertices).
+    /// Output: .npy (a_i as f32 [N] or [F, N], NaN for unused vertices; M as [N, k] or
+    /// [F, N, k] with --matrix, rows of unused vertices 0), .ply (one frame: colour, float
+    /// `ao` = a_i, NaN for unused vertices) or .glb (one frame: linear float COLOR_0, float
+    /// `_AO` = a_i, -1 for unused vertices). Unused: without a normal, because no triangle
+    /// (or only degenerate ones) uses them — the Stanford bunny has 1,113.
     #[arg(long)]
     out: Option<PathBuf>,
     /// Write the matrix M (M_ij = n_i·l_j where vertex i sees direction j, else 0) instead of

@@ -49,15 +49,19 @@ fn ambient_npy_keeps_vertex_order_with_nan_for_unused_vertices() {
     let out = dir.path().join("a.npy");
     let summary = run_visibility(&request(grid_obj(dir.path()), Some(out.clone())), None).unwrap();
     assert_eq!(
-        (summary.directions, summary.vertices, summary.frames),
-        (66, 26, 1)
+        (
+            summary.directions,
+            summary.vertices,
+            summary.unused,
+            summary.frames
+        ),
+        (66, 26, 1, 1)
     );
+    let line = summary.line();
     assert!(
-        summary
-            .line()
-            .starts_with("visibility: 66 directions x 26 vertices in "),
-        "{}",
-        summary.line()
+        line.starts_with("visibility: 66 directions x 26 vertices in ")
+            && line.ends_with("; 1 vertex without a normal (no triangle, or only degenerate ones, uses them): a_i = NaN (-1 in .glb)"),
+        "{line}"
     );
     let array = meshio::read_npy_f32(&out).unwrap();
     assert_eq!(array.shape, vec![26]);
