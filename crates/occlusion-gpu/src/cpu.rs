@@ -54,7 +54,8 @@
 //! Proofs that rays' far parts are free, in bulk, were tried as well. Rays cut at 0.02 /
 //! 0.05 / 0.1 / 0.2 × the diagonal trace in 0.54–0.59 / 0.67–0.72 / 0.79–0.87 / 0.97–1.04×
 //! the time of whole rays (bunny k = 258, BVH reused, two rounds): the ceiling of any such
-//! scheme, reached only if the proofs cost nothing. Two exact ones (M's hash unchanged) cost more than they saved:
+//! scheme, reached only if the proofs cost nothing. Two exact ones (M's hash unchanged) cost
+//! more than they saved:
 //!
 //! * a fat beam per chunk of 64 origins — the ray from the chunk's centre, every box grown by
 //!   the chunk's radius r — free of every leaf box beyond a start of r / 2r / 4r for 0 / 18
@@ -129,7 +130,12 @@ pub(crate) const EDGE_TOLERANCE: f32 = 1e-6;
 /// saving (bunny 28 → 24 ms, igea 143 → 120, dragon 112 → 89) outweighs the slightly worse
 /// tree. `very_fast_build` against `fast_build`: igea 0.94×, but the dragon 1.07× (its build
 /// 89 → 80 ms, its trace slower) and the bunny at k = 1026 1.01–1.02×; `slow_build` (spatial
-/// splits) was 1.06–1.15× `medium_build`'s time.
+/// splits) was 1.06–1.15× `medium_build`'s time. Within `fast_build` (bunny k = 258, best of 5,
+/// one session, M's hash unchanged throughout): the collapse's traversal cost at 1 / 2 / 3 /
+/// 4 / 6 (the leaves' size) gave 222 / 205 / 207 / 203 / 206 ms, a post-collapse reinsertion
+/// (× 1 / × 3) 200 / 209 ms and a reinsertion ratio of 0.05 / 0.1 215 / 214 ms, against
+/// 207–219 ms for the preset itself: flat within the machine's noise, except fewer triangles
+/// per leaf (cost 1), which is slower.
 fn fan_build() -> BvhBuildParams {
     BvhBuildParams::fast_build()
 }
