@@ -10,18 +10,20 @@
 //! Outputs by extension: `.npy` (f32 `[N]` open fraction, or `[N, 3]` radiance with a light;
 //! NaN for vertices used by no face), `.ply` (colour + float `ao`), `.glb` (linear `COLOR_0` +
 //! `_AO`, −1 for unused vertices), and `--render FILE.png|.exr` (the shared frame).
+//! `--up-axis` turns the environment's zenith and the camera's up onto a Z-up (or other)
+//! asset's up axis, as `visibility`'s does; the maps and outputs stay in the input's frame.
 
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
 use super::invalid;
+use super::up_axis::{UpAxis, turn_camera};
 use super::visibility::{
     DEFAULT_GAMMA, DEFAULT_RENDER_SIZE, check_render, display_colours, display_scene,
-    lower_extension, write_glb, write_ply,
+    lower_extension, turned_environment, write_glb, write_ply,
 };
 use cloth_vis::Error;
-use cloth_vis::lighting::environment_rotation;
 use cloth_vis::run::render_still_image;
 use cloth_vis::scene::Scene;
 use glam::Vec3;
@@ -74,8 +76,11 @@ pub struct HemicubeRequest {
     pub max_distance: Option<f32>,
     /// Environment (already loaded).
     pub environment: Option<lightsphere::Environment>,
-    /// Rotation of the environment about +Y, degrees.
+    /// Rotation of the environment about the up axis, degrees.
     pub rotation_deg: f32,
+    /// The input's up axis: the environment's zenith and the render camera's up turn onto it;
+    /// the maps and outputs stay in the input's frame.
+    pub up_axis: UpAxis,
     /// Environment look-up.
     pub lookup: EnvLookup,
     /// Point lights.
@@ -229,14 +234,16 @@ fn check_request(
 /// The one-object scene for loading and rendering: the input as a white object, clamp-then-gamma
 /// PNGs, the environment as backdrop.
 fn one_object_scene(request: &HemicubeRequest) -> Result<Scene, Error> {
-    display_scene(
+    let mut scene = display_scene(
         &request.input,
         request.topology.as_deref(),
         "cloth-vis hemicube",
         request.render_size,
         request.exposure_ev,
         DEFAULT_GAMMA,
-    )
+    )?;
+    turn_camera(&mut scene.camera, request.up_axis);
+    Ok(scene)
 }
 
 /// Builds the maps with the chosen builder.
@@ -346,10 +353,10 @@ pub fn run_hemicube(
     let maps = build_maps(request, &caster, layout, builder, gpu)?;
     let millis = t.elapsed().as_secs_f64() * 1e3;
     let open = maps.open_fraction();
-    let environment = request.environment.clone().map(|env| {
-        let world_from_env = environment_rotation(request.rotation_deg) * env.world_from_env();
-        env.with_rotation(world_from_env)
-    });
+    let environment = request
+        .environment
+        .clone()
+        .map(|env| turned_environment(env, request.up_axis, request.rotation_deg));
     let lit = environment.is_some() || !request.point_lights.is_empty();
     let radiance: Vec<Vec3> = if lit {
         let mut c = match &environment {
@@ -501,7 +508,7 @@ pub struct HemicubeArgs {
     /// The procedural sky as environment.
     #[arg(long)]
     sky: bool,
-    /// Rotate the environment by DEG about +Y (the maps are not rebuilt).
+    /// Rotate the environment by DEG about the up axis (the maps are not rebuilt).
     #[arg(
         long,
         value_name = "DEG",
@@ -509,6 +516,11 @@ pub struct HemicubeArgs {
         allow_negative_numbers = true
     )]
     rotation: f32,
+    /// The input's up axis: the environment's zenith and the render camera's up turn onto it
+    /// (z for Blender/CAD exports and the Berkeley garments); the maps and outputs stay in
+    /// the input's frame.
+    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
+    up_axis: UpAxis,
     /// Environment look-up: cube (power-conserving cube map, the seed's) or exact (per pixel
     /// direction).
     #[arg(long, default_value = "cube", value_parser = ["cube", "exact"])]
@@ -590,6 +602,7 @@ impl HemicubeArgs {
             max_distance: self.max_distance,
             environment,
             rotation_deg: self.rotation,
+            up_axis: self.up_axis,
             lookup: if self.lookup == "exact" {
                 EnvLookup::Exact
             } else {

@@ -40,3 +40,12 @@ pub fn up_axis_rotation(axis: UpAxis) -> glam::DQuat {
         UpAxis::NegY => glam::DQuat::from_rotation_x(PI),
     }
 }
+
+/// Turns an automatically framed camera onto `axis`: its up vector becomes `axis` and its
+/// viewing direction turns by the same [`up_axis_rotation`], so a Z-up asset is seen as a
+/// Y-up one would be.
+pub fn turn_camera(camera: &mut cloth_vis::scene::CameraDesc, axis: UpAxis) {
+    let up = up_axis_rotation(axis).as_quat();
+    camera.up = (up * glam::Vec3::Y).to_array();
+    camera.direction = (up * glam::Vec3::from(camera.direction)).to_array();
+}

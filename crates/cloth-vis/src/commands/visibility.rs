@@ -44,7 +44,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use super::up_axis::{UpAxis, up_axis_rotation};
+use super::up_axis::{UpAxis, turn_camera, up_axis_rotation};
 use super::{invalid, output_size};
 use cloth_vis::Error;
 use cloth_vis::lighting::{environment_rotation, shadowed_radiance};
@@ -337,9 +337,7 @@ fn one_object_scene(request: &VisibilityRequest) -> Result<Scene, Error> {
         Some(Backend::Query) => VisibilityBackendDesc::Query,
     };
     scene.visibility.depth_resolution = request.depth_resolution;
-    let up = up_axis_rotation(request.up_axis).as_quat();
-    scene.camera.up = (up * Vec3::Y).to_array();
-    scene.camera.direction = (up * Vec3::from(scene.camera.direction)).to_array();
+    turn_camera(&mut scene.camera, request.up_axis);
     Ok(scene)
 }
 
