@@ -70,6 +70,34 @@ pub enum AttributeStatus {
     },
 }
 
+impl std::fmt::Display for AttributeStatus {
+    /// `none in the file`, `loaded`, or why it was dropped with its counts, e.g. `dropped: per
+    /// face corner, 46 vertices whose corners differ`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Self::Absent => f.write_str("none in the file"),
+            Self::Loaded => f.write_str("loaded"),
+            Self::DroppedPerCorner {
+                conflicting_vertices,
+                missing_corners,
+            } => {
+                f.write_str("dropped: per face corner")?;
+                match conflicting_vertices {
+                    0 => {}
+                    1 => f.write_str(", 1 vertex whose corners differ")?,
+                    n => write!(f, ", {n} vertices whose corners differ")?,
+                }
+                match missing_corners {
+                    0 => {}
+                    1 => f.write_str(", 1 corner without a value")?,
+                    n => write!(f, ", {n} corners without a value")?,
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
 /// The glTF clip that was sampled.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ClipInfo {

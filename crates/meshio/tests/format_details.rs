@@ -92,4 +92,25 @@ fn obj_per_corner_attributes_kept_when_consistent_dropped_at_seams() {
             missing_corners: 0
         }
     );
+    // Readable as printed by `cloth-vis inspect` and in the notes (not the Debug form).
+    assert_eq!(
+        report.uvs.to_string(),
+        "dropped: per face corner, 1 vertex whose corners differ"
+    );
+    assert!(
+        report.notes.iter().any(|n| n.starts_with(
+            "texture coordinates dropped: per face corner, 1 vertex whose corners differ ("
+        )),
+        "{:?}",
+        report.notes
+    );
+    let partial = AttributeStatus::DroppedPerCorner {
+        conflicting_vertices: 0,
+        missing_corners: 2,
+    };
+    assert_eq!(
+        partial.to_string(),
+        "dropped: per face corner, 2 corners without a value"
+    );
+    assert_eq!(AttributeStatus::Absent.to_string(), "none in the file");
 }

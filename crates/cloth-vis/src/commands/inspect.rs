@@ -77,6 +77,7 @@ impl InspectArgs {
                 fmt3(hi),
                 (hi - lo).length()
             ));
+            lines.extend(up_axis_hint(hi - lo));
             if let Some(clip) = &report.clip {
                 lines.push(format!(
                     "clip {} {:?}: {:.3} s … {:.3} s",
@@ -100,7 +101,7 @@ impl InspectArgs {
             let (mesh, report) = meshio::load_mesh(input, &meshio::LoadOptions::default())?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
             let (lo, hi) = bounds(mesh.positions.iter());
-            let lines = vec![
+            let mut lines = vec![
                 format!(
                     "{}: mesh ({:?}), {} vertices, {} triangles, loaded in {ms:.1} ms",
                     input.display(),
@@ -115,6 +116,7 @@ impl InspectArgs {
                     (hi - lo).length()
                 ),
             ];
+            lines.extend(up_axis_hint(hi - lo));
             (lines, report)
         };
         for line in lines.iter().chain(&report_lines(&report)) {
@@ -127,14 +129,25 @@ impl InspectArgs {
     }
 }
 
+/// A note where the extent along Z is at least twice that along X and along Y — the shape of
+/// an asset authored Z-up (Blender, CAD exports, the Berkeley garments) standing upright, which
+/// the commands would light and frame lying on its side. Only a hint: a Y-up object can be
+/// long along Z.
+fn up_axis_hint(size: Vec3) -> Option<String> {
+    (size.z > 0.0 && size.z >= 2.0 * size.x.max(size.y)).then(|| {
+        format!(
+            "note: the extent along Z ({:.4}) is over twice that along X ({:.4}) and Y ({:.4}): \
+             if the asset stands along Z, pass --up-axis z to visibility, bake, hemicube and \
+             btf render (or rotate it in a scene file: rotation_deg = [-90, 0, 0])",
+            size.z, size.x, size.y
+        )
+    })
+}
+
 /// The loader's findings as readable lines: attributes, what the file holds that was
 /// triangulated, dropped or skipped, and its notes.
 fn report_lines(report: &LoadReport) -> Vec<String> {
-    let status = |s: &AttributeStatus| match s {
-        AttributeStatus::Absent => "none in the file".to_owned(),
-        AttributeStatus::Loaded => "loaded".to_owned(),
-        other => format!("dropped: {other:?}"),
-    };
+    let status = AttributeStatus::to_string;
     let mut lines = vec![format!(
         "normals: {}{}; texture coordinates: {}",
         status(&report.file_normals),

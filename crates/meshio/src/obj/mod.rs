@@ -45,7 +45,7 @@ pub(crate) fn into_raw(obj: ObjData, report: &mut LoadReport) -> RawMesh {
             .map_err(|status| {
                 report.uvs = status;
                 report.notes.push(format!(
-                    "texture coordinates dropped: they are per face corner and differ between the corners of a vertex ({status:?}); positions are kept as in the file"
+                    "texture coordinates {status} (no single value per vertex without splitting vertices at the seams); positions are kept as in the file"
                 ));
             })
             .ok()
@@ -55,7 +55,7 @@ pub(crate) fn into_raw(obj: ObjData, report: &mut LoadReport) -> RawMesh {
             .map_err(|status| {
                 report.file_normals = status;
                 report.notes.push(format!(
-                    "file normals dropped: they are per face corner and differ between the corners of a vertex ({status:?}); normals are computed"
+                    "file normals {status} (no single value per vertex without splitting vertices at the hard edges); normals are computed"
                 ));
             })
             .ok()

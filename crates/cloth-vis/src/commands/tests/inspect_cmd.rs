@@ -25,6 +25,10 @@ fn inspect_summarises_a_mesh_and_an_animation() {
     assert!(s.contains("unreferenced vertices: 1"), "{s}");
     assert!(s.contains("skipped keywords: o ×1"), "{s}");
     assert!(!s.contains("LoadReport {"), "{s}");
+    assert!(
+        !s.contains("--up-axis"),
+        "a cube's extent suggests no up axis: {s}"
+    );
     let debug = String::from_utf8(cli(&["inspect", text(&obj), "--debug"]).stdout).unwrap();
     assert!(debug.contains("LoadReport {"), "{debug}");
 
@@ -50,6 +54,36 @@ fn inspect_summarises_a_mesh_and_an_animation() {
         "{s}"
     );
     assert!(s.contains("frame files: 0001.obj … 0002.obj"), "{s}");
+}
+
+#[test]
+fn a_mesh_tall_along_z_gets_the_up_axis_hint() {
+    let dir = tempfile::tempdir().unwrap();
+    // A strip 0.4 wide (x), 0.3 deep (y), 1 tall (z): a Z-up garment's proportions.
+    let obj = dir.path().join("tall.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 0.4 0 0\nv 0.4 0.3 1\nv 0 0.3 1\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let out = cli(&["inspect", text(&obj)]);
+    assert!(out.status.success(), "{out:?}");
+    let s = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        s.contains(
+            "note: the extent along Z (1.0000) is over twice that along X (0.4000) and Y \
+             (0.3000): if the asset stands along Z, pass --up-axis z"
+        ),
+        "{s}"
+    );
+    // The same strip standing along Y: no hint.
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 0.4 0 0\nv 0.4 1 0.3\nv 0 1 0.3\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let s = String::from_utf8(cli(&["inspect", text(&obj)]).stdout).unwrap();
+    assert!(s.contains("extent: ") && !s.contains("--up-axis"), "{s}");
 }
 
 #[test]
