@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::invalid;
+use super::up_axis::{UpAxis, up_axis_rotation};
 use cloth_vis::scene::{
     AutoKeyword, BackgroundDesc, BackgroundKeyword, EnvironmentDesc, ExposureDesc, SineDeformDesc,
     TranslucencyDesc, TranslucencyLightDesc,
@@ -134,6 +135,11 @@ pub struct TranslucencyArgs {
     /// With --env: per-vertex self-shadowing (occlusion-gpu) instead of unshadowed lighting.
     #[arg(long, requires = "env")]
     self_shadowing: bool,
+    /// The input's up axis (z for Blender/CAD exports): the object is stood up — turned so
+    /// that this axis is +Y, the environment's zenith and the camera's up — before it is lit;
+    /// --light-pos and --light-dir stay in the input's frame.
+    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
+    up_axis: UpAxis,
     /// A measured material (Jensen et al. 2001): apple, chicken1, chicken2, cream, ketchup,
     /// marble, potato, skimmilk, skin1, skin2, spectralon, wholemilk.
     #[arg(long, default_value = "marble", conflicts_with = "sigma_a")]
@@ -249,15 +255,19 @@ impl TranslucencyArgs {
             Some(ev) => ExposureDesc::Fixed(ev),
             None => ExposureDesc::Auto(AutoKeyword::Auto),
         };
+        // Standing the object up turns the input's frame into the world's: its lights too.
+        let stand = up_axis_rotation(self.up_axis).inverse();
+        let (rx, ry, rz) = stand.to_euler(glam::EulerRot::XYZ);
+        scene.objects[0].rotation_deg = [rx, ry, rz].map(|a| a.to_degrees() as f32);
         let mut effects = vec!["translucency".to_owned()];
         let light = match (self.light_pos, self.light_dir, &self.env) {
             (Some(p), _, _) => TranslucencyLightDesc {
-                position: Some(p.as_dvec3().to_array()),
+                position: Some((stand * p.as_dvec3()).to_array()),
                 intensity: self.power.map(|v| v.to_array()),
                 ..Default::default()
             },
             (None, Some(d), _) => TranslucencyLightDesc {
-                direction: Some(d.as_dvec3().to_array()),
+                direction: Some((stand * d.as_dvec3()).to_array()),
                 irradiance: Some(self.power.map_or([1.0; 3], |v| v.to_array())),
                 ..Default::default()
             },

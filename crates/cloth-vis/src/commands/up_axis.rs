@@ -2,6 +2,8 @@
 //! framed as they stand. The environment's zenith (+Y of a lat-long map) and the default camera
 //! up turn onto the input's up axis; the geometry and every per-vertex output stay in the
 //! input's frame, so a_i and M are untouched and only look-ups of the environment change.
+//! `translucency`, whose outputs are pictures only, stands the object up instead (its scene
+//! rotation, the inverse of [`up_axis_rotation`]) and turns the lights given in its frame.
 
 /// An input's up axis (`--up-axis`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
