@@ -64,3 +64,22 @@ pub fn read_exr_rgba(path: &Path) -> (usize, usize, Vec<[f32; 4]>) {
         image.layer_data.channel_data.pixels.1,
     )
 }
+
+/// The OBJ `obj` authored Z-up, written beside it as `z_up.obj`: every vertex (x, y, z) becomes
+/// (x, −z, y), a quarter turn about +x that takes +y to +z.
+pub fn z_up_copy(obj: &Path) -> PathBuf {
+    let turned: String = std::fs::read_to_string(obj)
+        .unwrap()
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(rest) => {
+                let v: Vec<f32> = rest.split(' ').map(|t| t.parse().unwrap()).collect();
+                format!("v {} {} {}\n", v[0], -v[2], v[1])
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    let path = obj.with_file_name("z_up.obj");
+    std::fs::write(&path, turned).unwrap();
+    path
+}

@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use super::common::{cli, text};
+use super::common::{cli, text, z_up_copy};
 use glam::Vec3;
 
 /// A 5×5 floor facing +y, a 2×2 roof 0.5 above its middle (facing down), and one vertex used
@@ -198,20 +198,8 @@ fn a_z_up_copy_with_up_axis_z_gets_the_radiance_of_the_y_up_original() {
     use crate::commands::up_axis::UpAxis;
     let dir = tempfile::tempdir().unwrap();
     let input = floor_and_roof(dir.path());
-    // The same scene authored Z-up: (x, y, z) → (x, −z, y), a quarter turn about +X.
-    let turned: String = std::fs::read_to_string(&input)
-        .unwrap()
-        .lines()
-        .map(|line| match line.strip_prefix("v ") {
-            Some(rest) => {
-                let v: Vec<f32> = rest.split(' ').map(|t| t.parse().unwrap()).collect();
-                format!("v {} {} {}\n", v[0], -v[2], v[1])
-            }
-            None => format!("{line}\n"),
-        })
-        .collect();
-    let z_up = dir.path().join("z_up.obj");
-    std::fs::write(&z_up, turned).unwrap();
+    // The same scene authored Z-up.
+    let z_up = z_up_copy(&input);
     // A smooth lat-long map: bright zenith, dim nadir, a gentle swing in azimuth.
     let (w, h) = (64usize, 32usize);
     let texels = (0..w * h)

@@ -517,20 +517,8 @@ fn a_z_up_copy_with_up_axis_z_gets_the_colours_of_the_y_up_original() {
     use crate::commands::up_axis::UpAxis;
     let dir = tempfile::tempdir().unwrap();
     let input = fold_obj(dir.path());
-    // The same fold authored Z-up: (x, y, z) → (x, −z, y), a quarter turn about +X.
-    let text = std::fs::read_to_string(&input).unwrap();
-    let turned: String = text
-        .lines()
-        .map(|line| match line.strip_prefix("v ") {
-            Some(rest) => {
-                let v: Vec<f32> = rest.split(' ').map(|t| t.parse().unwrap()).collect();
-                format!("v {} {} {}\n", v[0], -v[2], v[1])
-            }
-            None => format!("{line}\n"),
-        })
-        .collect();
-    let z_up = dir.path().join("z_up.obj");
-    std::fs::write(&z_up, turned).unwrap();
+    // The same fold authored Z-up.
+    let z_up = super::common::z_up_copy(&input);
     let colours = |input: &Path, up_axis: UpAxis, name: &str| {
         let glb = dir.path().join(name);
         let request = VisibilityRequest {
