@@ -165,17 +165,13 @@ impl VisibilitySummary {
         } else {
             String::new()
         };
-        let unused = if self.unused > 0 {
-            let (n, noun) = match self.unused {
-                1 => (1, "vertex"),
-                n => (n, "vertices"),
-            };
-            format!(
-                "; {n} {noun} without a normal (no triangle, or only degenerate ones, uses them): \
-                 a_i = NaN (-1 in .glb)"
-            )
-        } else {
-            String::new()
+        let unused = match self.unused {
+            0 => String::new(),
+            n => format!(
+                "; {n} {} without a normal (no triangle, or only degenerate ones, uses them): \
+                 a_i = NaN (-1 in .glb)",
+                if n == 1 { "vertex" } else { "vertices" }
+            ),
         };
         format!(
             "visibility: {} directions x {} vertices{frames} in {:.1} ms ({}){unused}",
