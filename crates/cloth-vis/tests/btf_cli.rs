@@ -196,6 +196,11 @@ fn bad_input_is_refused_naming_the_file_and_nothing_is_written() {
     let out = cli(&["btf", "stats", text(&a), text(&corrupt)]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("c.btfpca"), "{}", stderr(&out));
+    // The two files the wrong way round: the order, and the command that was meant.
+    let out = cli(&["btf", "stats", text(&fa), text(&a)]);
+    assert!(!out.status.success());
+    let meant = format!("`cloth-vis btf stats {} {}`", a.display(), fa.display());
+    assert!(stderr(&out).contains(&meant), "{}", stderr(&out));
 }
 
 #[test]

@@ -262,6 +262,7 @@ pub fn run_compress(request_: &CompressRequest) -> Result<CompressSummary, Error
 /// Folder and file errors naming the file; a `.btfpca` of another size or sampling than the
 /// folder, naming both.
 pub fn run_stats(dir: &Path, file: &Path, progress: bool) -> Result<StatsSummary, Error> {
+    super::refuse_swapped_stats("btf stats", dir, file, "btfpca")?;
     let pca = BtfPca::read(file)?;
     let folder = BtfDir::open(dir)?;
     let (a, b) = (

@@ -377,6 +377,7 @@ pub fn run_stats_with_pictures(
     gpu: Option<&gpu_context::GpuContext>,
 ) -> Result<StatsSummary, Error> {
     let (original, cpca) = (request.original.as_path(), request.cpca.as_path());
+    super::refuse_swapped_stats("anim stats", original, cpca, "cpca")?;
     for (path, ext) in [(&request.clusters_png, "png"), (&request.error_plot, "svg")] {
         if let Some(p) = path.as_ref().filter(|p| {
             p.extension()

@@ -64,6 +64,32 @@ pub fn invalid(path: &std::path::Path, message: String) -> cloth_vis::Error {
     }
 }
 
+/// A `stats` command given its two files the wrong way round: the compressed file (`.ext`)
+/// where the original goes and something else after it. Refused with the order spelled out
+/// and the command that was meant, instead of the reader's complaint about the wrong kind of
+/// file.
+pub fn refuse_swapped_stats(
+    command: &str,
+    original: &std::path::Path,
+    compressed: &std::path::Path,
+    ext: &str,
+) -> Result<(), cloth_vis::Error> {
+    let is_compressed =
+        |p: &std::path::Path| visibility::lower_extension(p).as_deref() == Some(ext) && !p.is_dir();
+    if is_compressed(original) && !is_compressed(compressed) {
+        return Err(invalid(
+            original,
+            format!(
+                "this .{ext} is given where the original goes; the order is `cloth-vis \
+                 {command} ORIGINAL FILE.{ext}`: `cloth-vis {command} {} {}`",
+                compressed.display(),
+                original.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// An `anim-pca` error about the file `path` (its message names the parameter and value).
 pub fn anim_error(path: &std::path::Path, e: anim_pca::AnimPcaError) -> cloth_vis::Error {
     invalid(path, e.to_string())

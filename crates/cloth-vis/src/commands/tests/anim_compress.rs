@@ -154,6 +154,16 @@ fn round_trip_through_the_cli_reproduces_the_clip_and_stats_match_the_library() 
     ] {
         assert!(stats.contains(&expected), "{stats:?} lacks {expected:?}");
     }
+    // The two files the wrong way round: the order, and the command that was meant.
+    let swapped = cli(&["anim", "stats", text(&cpca), text(&input)]);
+    let said = String::from_utf8_lossy(&swapped.stderr);
+    assert!(!swapped.status.success(), "{said}");
+    let meant = format!(
+        "`cloth-vis anim stats {} {}`",
+        input.display(),
+        cpca.display()
+    );
+    assert!(said.contains(&meant), "{said}");
     // The library call agrees with the binary.
     let summary = run_stats(&input, &cpca).unwrap();
     assert_eq!(summary.line(), stats.trim_end());
