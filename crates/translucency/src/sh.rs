@@ -119,6 +119,23 @@ pub enum Window {
 /// everywhere (rounded down; tested).
 pub const GAUSSIAN_NON_NEGATIVE_WIDTH: f64 = 5.0;
 
+/// For reports: "no window", "Lanczos σ window, w = 3" or "Gaussian window, w = 5", with the
+/// band factors h_1, h_2 when there is a window.
+impl std::fmt::Display for Window {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (name, width) = match *self {
+            Window::None => return write!(f, "no window"),
+            Window::Lanczos { width } => ("Lanczos σ", width),
+            Window::Gaussian { width } => ("Gaussian", width),
+        };
+        let [_, h1, h2] = self.factors();
+        write!(
+            f,
+            "{name} window, w = {width}: h_1 = {h1:.4}, h_2 = {h2:.4}"
+        )
+    }
+}
+
 impl Window {
     /// h_l for bands 0, 1, 2 (h_0 = 1 always).
     #[must_use]

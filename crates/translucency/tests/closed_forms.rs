@@ -363,3 +363,18 @@ fn dipole_diffuse_reflectance_matches_jensens_table() {
         .diffuse_reflectance();
     assert!(ink[0] < 0.01);
 }
+
+#[test]
+fn a_window_reports_its_closed_form_band_factors() {
+    // Lanczos: h_l = sinc(l / 3), sin(π/3)/(π/3) = 0.8270, sin(2π/3)/(2π/3) = 0.4135;
+    // Gaussian: h_l = exp(−l(l + 1) / 10), e^−0.2 = 0.8187, e^−0.6 = 0.5488.
+    assert_eq!(sh::Window::None.to_string(), "no window");
+    assert_eq!(
+        sh::Window::Lanczos { width: 3.0 }.to_string(),
+        "Lanczos σ window, w = 3: h_1 = 0.8270, h_2 = 0.4135"
+    );
+    assert_eq!(
+        sh::Window::Gaussian { width: 5.0 }.to_string(),
+        "Gaussian window, w = 5: h_1 = 0.8187, h_2 = 0.5488"
+    );
+}

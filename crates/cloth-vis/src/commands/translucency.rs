@@ -87,7 +87,7 @@ impl ShArgs {
         let flat: Vec<f32> = sh.to_f32().iter().flatten().copied().collect();
         meshio::write_npy_f32(&self.out, &[9, 3], &flat)?;
         let mut text = format!(
-            "sh: {} × {} map projected exactly in {millis:.1} ms ({window:?}); E00 = {:.5}, {:.5}, {:.5}\n\
+            "sh: {} × {} map projected exactly in {millis:.1} ms ({window}); E00 = {:.5}, {:.5}, {:.5}\n\
              irradiance B(r) = r̃ᵀ M r̃ (eq. 10; unclamped, a negative value is ringing):\n",
             env.width(),
             env.height(),

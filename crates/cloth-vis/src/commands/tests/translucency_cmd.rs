@@ -63,6 +63,7 @@ fn sh_of_a_uniform_map_is_its_closed_form() {
     let e00 = 4.0 * std::f32::consts::PI * translucency::sh::K0 as f32 * 2.0;
     assert!((e.data[0] - e00).abs() < 1e-5, "{:?}", &e.data[..3]);
     assert!(e.data[3..].iter().all(|v| v.abs() < 1e-5), "{:?}", e.data);
+    assert!(stdout.contains(" ms (no window); E00 = "), "{stdout}");
     // B = π·L along every axis.
     assert_eq!(
         stdout.matches("6.28319 6.28319 6.28319").count(),
