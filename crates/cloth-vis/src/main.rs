@@ -1,6 +1,7 @@
 //! The `cloth-vis` command line: one subcommand per file in [`commands`], each with its clap
 //! arguments and the work it does through the library (`cloth_vis`) and the domain crates.
 
+use std::path::Path;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
@@ -59,6 +60,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    quiet_headless_device_select();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     // Ctrl-C or SIGTERM mid-write removes the temporary files: no partial output survives.
     if let Err(e) = atomic_out::remove_temporaries_on_signal() {
@@ -108,4 +110,30 @@ fn message(e: &anyhow::Error) -> String {
         }
     }
     text
+}
+
+/// Mesa's device-select Vulkan layer (installed with `mesa-vulkan-drivers`, lavapipe's
+/// package) connects to Wayland while it lists the devices, and where there is no session
+/// (CI, render nodes, ssh, containers) libwayland prints "error: XDG_RUNTIME_DIR is invalid or
+/// not set in the environment." to stderr, twice per GPU command, worded like one of our own
+/// errors. The layer only reorders the devices, and `gpu_context` picks its adapter itself, so
+/// where that connection cannot succeed the layer is switched off (`NODEVICE_SELECT=1`),
+/// unless the user steers it (`MESA_VK_DEVICE_SELECT`, `DRI_PRIME`, or `NODEVICE_SELECT`
+/// itself).
+fn quiet_headless_device_select() {
+    let set = |name: &str| std::env::var_os(name).is_some_and(|v| !v.is_empty());
+    let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| Path::new(&d).is_dir());
+    if runtime_dir
+        || ["NODEVICE_SELECT", "MESA_VK_DEVICE_SELECT", "DRI_PRIME"]
+            .into_iter()
+            .any(set)
+    {
+        return;
+    }
+    // SAFETY: the first statement of `main`, before any thread exists (the signal handler
+    // and rayon's pool start after it), so nothing reads the environment concurrently.
+    #[allow(unsafe_code)]
+    unsafe {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
 }

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::common::{cli, text};
+use super::common::{binary, cli, text};
 
 /// A unit square at height 1 centred over (0.25, 0), wound to face down (the light is above:
 /// one-sided casting would drop it, two-sided must keep it; the command picks two-sided for a
@@ -134,6 +134,38 @@ fn a_lod_caster_and_a_picture() {
     let mask = meshio::read_npy_f32(&out).unwrap();
     let share = mask.data.iter().sum::<f32>() / mask.data.len() as f32;
     assert!((share - 0.21).abs() < 0.03, "{share}");
+}
+
+/// Mesa's device-select layer has libwayland print "error: XDG_RUNTIME_DIR is invalid or not
+/// set in the environment." where no session exists; the binary switches the layer off there
+/// (`main.rs`), so a headless run's stderr holds nothing but its own messages.
+#[test]
+fn a_headless_gpu_run_prints_no_wayland_error() {
+    if !gpu() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let input = square(dir.path());
+    let out = dir.path().join("mask.npy");
+    let run = std::process::Command::new(binary())
+        .args([
+            "shadows",
+            text(&input),
+            "--light-dir",
+            "0,1,0",
+            "--ground",
+            "0",
+        ])
+        .args(["--grid", "8", "--out", text(&out)])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("MESA_VK_DEVICE_SELECT")
+        .env_remove("DRI_PRIME")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
 }
 
 #[test]
