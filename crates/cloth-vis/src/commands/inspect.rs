@@ -138,7 +138,7 @@ fn up_axis_hint(size: Vec3) -> Option<String> {
         format!(
             "note: the extent along Z ({:.4}) is over twice that along X ({:.4}) and Y ({:.4}): \
              if the asset stands along Z, pass --up-axis z to visibility, bake, hemicube, \
-             translucency and btf render (or rotate it in a scene file: rotation_deg = [-90, 0, \
+             shadows, translucency, btf render and view (or rotate it in a scene file: rotation_deg = [-90, 0, \
              0])",
             size.z, size.x, size.y
         )

@@ -9,11 +9,17 @@
 //! above, or by exact rays through a BVH with `--cpu`. `--render` draws the mesh over the
 //! ground lit by the light through the shared frame's shadow volumes, with eq. 5.6's smooth
 //! boundary (`--alpha`).
+//!
+//! `--up-axis` stands an asset authored with another axis up onto +Y first (an exact quarter
+//! or half turn, [`stand_up_matrix`]), its lights with it: the ground is then the plane at
+//! height Y along the input's up axis, and x/z above are the stood-up frame's (for `z`: the
+//! file's x and −y).
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use super::invalid;
+use super::up_axis::{UpAxis, stand_up_matrix};
 use super::visibility::{DEFAULT_GAMMA, DEFAULT_RENDER_SIZE, check_render, display_scene};
 use cloth_vis::Error;
 use cloth_vis::object::WorldObject;
@@ -44,10 +50,16 @@ pub struct ShadowsArgs {
     /// A directional light: the direction X,Y,Z towards it.
     #[arg(long, value_name = "X,Y,Z", value_parser = super::parse::vec3, allow_hyphen_values = true)]
     light_dir: Option<Vec3>,
-    /// Height Y of the ground plane y = Y.
+    /// Height Y of the ground plane y = Y (with --up-axis: the height along that axis).
     #[arg(long, value_name = "Y", allow_negative_numbers = true)]
     ground: f64,
-    /// The sampled extent X0,Z0,X1,Z1 (default: the mesh's x/z box scaled ×3 about its centre).
+    /// The input's up axis: the mesh and the lights (given in the input's frame) are stood up
+    /// onto +Y by an exact quarter or half turn before casting, so the ground lies under an
+    /// asset authored Z-up (Blender, CAD, the Berkeley garments).
+    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
+    up_axis: UpAxis,
+    /// The sampled extent X0,Z0,X1,Z1 (default: the mesh's x/z box scaled ×3 about its centre;
+    /// with --up-axis, the stood-up frame's x/z: for z, the input's x and −y).
     #[arg(long, value_name = "X0,Z0,X1,Z1", value_parser = parse_extent, allow_hyphen_values = true)]
     ground_extent: Option<[f64; 4]>,
     /// Cells per side of the mask.
@@ -172,7 +184,19 @@ impl ShadowsArgs {
             .into());
         }
         objects[0].pose(self.frame);
-        let mesh = objects.swap_remove(0);
+        let mut mesh = objects.swap_remove(0);
+        let light = if self.up_axis == UpAxis::PosY {
+            light
+        } else {
+            let stand = stand_up_matrix(self.up_axis);
+            mesh.animation = None;
+            mesh.pose_positions(&mesh.positions.clone(), stand);
+            let turn = glam::DMat3::from_mat4(stand.as_dmat4());
+            match light {
+                Light::Point(p) => Light::Point(turn * p),
+                Light::Directional(d) => Light::Directional(turn * d),
+            }
+        };
         if mesh.triangles.is_empty() {
             return Err(invalid(
                 &self.input,
@@ -245,10 +269,10 @@ impl ShadowsArgs {
         }
         let shadowed = mask.iter().filter(|&&v| v > 0.0).count() as f64 / mask.len() as f64;
         super::print_line(&format!(
-            "shadows: {} triangles (caster) in {millis:.1} ms{lod_note}, {method}, {:?}-sided, \
+            "shadows: {} triangles (caster) in {millis:.1} ms{lod_note}, {method}, {}-sided, \
              {} x {} cells, {:.2} % shadowed",
             caster.len(),
-            sides,
+            if sides == Sides::Two { "two" } else { "one" },
             grid.n,
             grid.n,
             100.0 * shadowed

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::invalid;
-use super::up_axis::{UpAxis, up_axis_rotation};
+use super::up_axis::{UpAxis, stand_up_degrees, up_axis_rotation};
 use cloth_vis::scene::{
     AutoKeyword, BackgroundDesc, BackgroundKeyword, EnvironmentDesc, ExposureDesc, SineDeformDesc,
     TranslucencyDesc, TranslucencyLightDesc,
@@ -257,8 +257,7 @@ impl TranslucencyArgs {
         };
         // Standing the object up turns the input's frame into the world's: its lights too.
         let stand = up_axis_rotation(self.up_axis).inverse();
-        let (rx, ry, rz) = stand.to_euler(glam::EulerRot::XYZ);
-        scene.objects[0].rotation_deg = [rx, ry, rz].map(|a| a.to_degrees() as f32);
+        scene.objects[0].rotation_deg = stand_up_degrees(self.up_axis);
         let mut effects = vec!["translucency".to_owned()];
         let light = match (self.light_pos, self.light_dir, &self.env) {
             (Some(p), _, _) => TranslucencyLightDesc {

@@ -43,6 +43,26 @@ pub fn up_axis_rotation(axis: UpAxis) -> glam::DQuat {
     }
 }
 
+/// The rotation standing an input authored with `axis` up onto +Y (the inverse of
+/// [`up_axis_rotation`]) as an exact matrix: every entry is 0 or ±1, so turned positions keep
+/// their bits and a mask or picture of the stood-up asset matches that of a Y-up original.
+pub fn stand_up_matrix(axis: UpAxis) -> glam::Mat4 {
+    let m = glam::DMat3::from_quat(up_axis_rotation(axis).inverse());
+    glam::Mat4::from_mat3(glam::Mat3::from_cols_array(
+        &m.to_cols_array().map(|v| v.round() as f32),
+    ))
+}
+
+/// A scene object's `rotation_deg` (XYZ Euler angles) standing an input authored with `axis`
+/// up onto +Y: how `translucency` and `view`, whose outputs are pictures only, stand the
+/// object up in a Y-up world.
+pub fn stand_up_degrees(axis: UpAxis) -> [f32; 3] {
+    let (rx, ry, rz) = up_axis_rotation(axis)
+        .inverse()
+        .to_euler(glam::EulerRot::XYZ);
+    [rx, ry, rz].map(|a| a.to_degrees() as f32)
+}
+
 /// Turns an automatically framed camera onto `axis`: its up vector becomes `axis` and its
 /// viewing direction turns by the same [`up_axis_rotation`], so a Z-up asset is seen as a
 /// Y-up one would be.

@@ -9,6 +9,7 @@ use cloth_vis::Scene;
 use cloth_vis::live::ViewEvent;
 
 use super::invalid;
+use super::up_axis::{UpAxis, stand_up_degrees};
 
 /// Open a scene, mesh or animation in an interactive window.
 #[derive(clap::Args)]
@@ -56,6 +57,10 @@ pub struct ViewArgs {
     /// Seed of the jump map's random play.
     #[arg(long, default_value_t = 1, requires = "jumpmap")]
     seed: u64,
+    /// A mesh's or animation's up axis: the object is stood up onto +Y, the world's up (a
+    /// scene file stands its objects up with `rotation_deg`).
+    #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
+    up_axis: UpAxis,
 }
 
 /// Where the poses come from besides the scene's own clip.
@@ -131,6 +136,14 @@ impl ViewArgs {
             return Err(invalid(
                 &self.input,
                 "--frames 0 presents nothing".to_owned(),
+            ));
+        }
+        if self.is_scene() && self.up_axis != UpAxis::PosY {
+            return Err(invalid(
+                &self.input,
+                "--up-axis stands a mesh or an animation up; a scene stands its objects up \
+                 itself ([[object]] rotation_deg, e.g. [-90, 0, 0] for a Z-up asset)"
+                    .to_owned(),
             ));
         }
         if let Some(ms) = self.adaptive
@@ -271,7 +284,7 @@ impl ViewArgs {
         if self.is_scene() {
             return Scene::load(input);
         }
-        mesh_scene(input, self.env.first().map(PathBuf::as_path))
+        mesh_scene(input, self.env.first().map(PathBuf::as_path), self.up_axis)
     }
 
     fn is_scene(&self) -> bool {
@@ -289,9 +302,10 @@ impl ViewArgs {
     }
 }
 
-/// A mesh or animation as a scene: one two-sided light-grey object lit by the procedural sky
-/// (or `env`) over lightsphere level 3 with self-shadowing, over the environment.
-fn mesh_scene(path: &Path, env: Option<&Path>) -> Result<Scene, cloth_vis::Error> {
+/// A mesh or animation as a scene: one two-sided light-grey object, stood up from `up`, lit by
+/// the procedural sky (or `env`) over lightsphere level 3 with self-shadowing, over the
+/// environment.
+fn mesh_scene(path: &Path, env: Option<&Path>, up: UpAxis) -> Result<Scene, cloth_vis::Error> {
     let text_of = |p: &Path| -> Result<String, cloth_vis::Error> {
         let s = p
             .to_str()
@@ -313,7 +327,9 @@ fn mesh_scene(path: &Path, env: Option<&Path>) -> Result<Scene, cloth_vis::Error
          background = \"environment\"\n",
         name = toml::Value::String(name.clone()),
     );
-    Scene::from_toml(&text, Path::new(""), &path.display().to_string())
+    let mut scene = Scene::from_toml(&text, Path::new(""), &path.display().to_string())?;
+    scene.objects[0].rotation_deg = stand_up_degrees(up);
+    Ok(scene)
 }
 
 fn check_image_path(path: &Path) -> Result<(), cloth_vis::Error> {
@@ -345,7 +361,7 @@ mod tests {
 
     #[test]
     fn a_mesh_scene_is_lit_and_self_shadowed() {
-        let scene = mesh_scene(Path::new("some dir/bunny \"x\".obj"), None).unwrap();
+        let scene = mesh_scene(Path::new("some dir/bunny \"x\".obj"), None, UpAxis::PosY).unwrap();
         assert_eq!(scene.effects, ["lighting", "self-shadowing"]);
         assert_eq!(scene.objects.len(), 1);
         assert!(
@@ -354,5 +370,24 @@ mod tests {
                 .ends_with("some dir/bunny \"x\".obj")
         );
         assert!(scene.objects[0].two_sided);
+        assert_eq!(scene.objects[0].rotation_deg, [0.0; 3]);
+    }
+
+    #[test]
+    fn an_up_axis_stands_the_object_up_onto_y() {
+        for (up, axis) in [
+            (UpAxis::PosZ, glam::Vec3::Z),
+            (UpAxis::NegZ, glam::Vec3::NEG_Z),
+            (UpAxis::PosX, glam::Vec3::X),
+            (UpAxis::NegX, glam::Vec3::NEG_X),
+            (UpAxis::NegY, glam::Vec3::NEG_Y),
+        ] {
+            let scene = mesh_scene(Path::new("dress.obj"), None, up).unwrap();
+            let world = scene.objects[0].world_from_object();
+            let stood = world.transform_vector3(axis);
+            assert!(stood.abs_diff_eq(glam::Vec3::Y, 1e-6), "{up:?}: {stood}");
+            // A proper rotation: lengths and handedness kept.
+            assert!((world.determinant() - 1.0).abs() < 1e-6, "{up:?}");
+        }
     }
 }

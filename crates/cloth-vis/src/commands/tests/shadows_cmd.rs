@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use super::common::{binary, cli, text};
+use super::common::{binary, cli, text, z_up_copy};
 
 /// A unit square at height 1 centred over (0.25, 0), wound to face down (the light is above:
 /// one-sided casting would drop it, two-sided must keep it; the command picks two-sided for a
@@ -70,7 +70,7 @@ fn the_mask_covers_the_squares_shadow_in_the_issues_row_and_column_order() {
             stdout.starts_with("shadows: 2 triangles (caster) in "),
             "{stdout}"
         );
-        assert!(stdout.contains("Two-sided"), "{stdout}");
+        assert!(stdout.contains(", two-sided,"), "{stdout}");
         let mask = meshio::read_npy_f32(&out).unwrap();
         assert_eq!(mask.shape, [8, 8]);
         assert_eq!(mask.data, expected, "{mode}");
@@ -125,7 +125,7 @@ fn a_lod_caster_and_a_picture() {
         "{stdout}"
     );
     assert!(
-        stdout.contains("One-sided") && stdout.contains("Hausdorff"),
+        stdout.contains(", one-sided,") && stdout.contains("Hausdorff"),
         "{stdout}"
     );
     assert!(picture.is_file());
@@ -134,6 +134,55 @@ fn a_lod_caster_and_a_picture() {
     let mask = meshio::read_npy_f32(&out).unwrap();
     let share = mask.data.iter().sum::<f32>() / mask.data.len() as f32;
     assert!((share - 0.21).abs() < 0.03, "{share}");
+}
+
+#[test]
+fn a_z_up_copy_with_up_axis_z_casts_the_y_up_originals_mask() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = square(dir.path());
+    let z_up = z_up_copy(&input);
+    let mut modes = vec!["--cpu"];
+    if gpu() {
+        modes.push("--sides=two");
+    }
+    // Each light in the Y-up frame and in the Z-up copy's, (x, y, z) ↦ (x, −z, y).
+    let lights = [
+        ("--light-pos", "0.4,3,0.3", "0.4,-0.3,3"),
+        ("--light-dir", "0.2,1,0.1", "0.2,-0.1,1"),
+    ];
+    for mode in modes {
+        for (flag, y_up_light, z_up_light) in lights {
+            let mask = |mesh: &Path, light: &str, up: &str| {
+                let out = dir.path().join("mask.npy");
+                let (ok, _, stderr) = run(&[
+                    "shadows",
+                    text(mesh),
+                    flag,
+                    light,
+                    "--ground",
+                    "0",
+                    "--ground-extent",
+                    "-1,-2,1,2",
+                    "--grid",
+                    "16",
+                    "--up-axis",
+                    up,
+                    mode,
+                    "--out",
+                    text(&out),
+                ]);
+                assert!(ok, "{mode} {flag} {up}: {stderr}");
+                meshio::read_npy_f32(&out).unwrap().data
+            };
+            let original = mask(&input, y_up_light, "y");
+            let covered = original.iter().filter(|&&v| v > 0.0).count();
+            assert!((20..100).contains(&covered), "{mode} {flag}: {covered}");
+            // Stood up by an exact quarter turn: the same mask, cell for cell.
+            assert_eq!(mask(&z_up, z_up_light, "z"), original, "{mode} {flag}");
+            // Left lying, the square stands edge-on across the ground: another mask.
+            assert_ne!(mask(&z_up, z_up_light, "y"), original, "{mode} {flag}");
+        }
+    }
 }
 
 /// Mesa's device-select layer has libwayland print "error: XDG_RUNTIME_DIR is invalid or not
