@@ -595,7 +595,8 @@ pub struct RenderArgs {
     /// Texture repeats across the mesh's UV range.
     #[arg(long, default_value_t = 4.0)]
     uv_scale: f32,
-    /// Also draw plain texture mapping of the same material beside it (Fig. 5.16).
+    /// Also draw plain texture mapping of the same material beside it (Fig. 5.16); under one
+    /// light (--light-dir or --light-pos) of a single frame, without --fins or --part.
     #[arg(long)]
     beside_plain: bool,
     /// Use the CPU reference renderer (no GPU needed).
