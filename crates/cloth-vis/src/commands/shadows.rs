@@ -93,6 +93,32 @@ pub struct ShadowsArgs {
     render_size: [u32; 2],
 }
 
+/// Why no mesh can shadow the ground y = `ground` (in the stood-up frame), when that is so: the
+/// mesh lies wholly at or below it, or the light does. Said beside an all-lit mask, which is
+/// otherwise a silent surprise.
+fn nothing_casts(positions: &[Vec3], light: &Light, ground: f64) -> Option<String> {
+    let top = positions
+        .iter()
+        .map(|p| f64::from(p.y))
+        .fold(f64::NEG_INFINITY, f64::max);
+    if top <= ground {
+        return Some(format!(
+            "the mesh lies at or below the ground (its top at height {top:.4} ≤ {ground})"
+        ));
+    }
+    match *light {
+        Light::Point(p) if p.y <= ground => Some(format!(
+            "the light at height {:.4} is at or below the ground at {ground}",
+            p.y
+        )),
+        Light::Directional(d) if d.y <= 0.0 => Some(format!(
+            "the light direction ({:.3}, {:.3}, {:.3}) points at or below the horizon",
+            d.x, d.y, d.z
+        )),
+        _ => None,
+    }
+}
+
 /// Parse `X0,Z0,X1,Z1`.
 fn parse_extent(text: &str) -> Result<[f64; 4], String> {
     let values: Vec<f64> = text
@@ -264,6 +290,7 @@ impl ShadowsArgs {
         };
         let millis = start.elapsed().as_secs_f64() * 1e3;
         meshio::write_npy_f32(&self.out, &[grid.n, grid.n], &mask)?;
+        let unshadowable = nothing_casts(&mesh.positions, &light, grid.y);
         if let (Some(path), Some(gpu)) = (&self.render, &gpu) {
             self.draw(path, gpu, &scene, mesh, (&grid, &mask), light, sides)?;
         }
@@ -276,7 +303,14 @@ impl ShadowsArgs {
             grid.n,
             grid.n,
             100.0 * shadowed
-        ))
+        ))?;
+        if let Some(why) = unshadowable {
+            super::print_line(&format!(
+                "note: {why}, so nothing can shadow the ground (--ground is a height along the \
+                 up axis, --light-dir points towards the light)"
+            ))?;
+        }
+        Ok(())
     }
 
     /// Draw the mesh over the ground quad of the grid's extent, lit by `light` through the

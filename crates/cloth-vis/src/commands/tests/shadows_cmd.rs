@@ -218,6 +218,57 @@ fn a_headless_gpu_run_prints_no_wayland_error() {
 }
 
 #[test]
+fn an_all_lit_mask_that_nothing_could_shadow_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = square(dir.path());
+    let out = dir.path().join("mask.npy");
+    // The square is at y = 1.
+    for (light, ground, why) in [
+        (
+            ["--light-dir", "0,1,0"],
+            "2",
+            "the mesh lies at or below the ground",
+        ),
+        (
+            ["--light-dir", "0.3,-1,0"],
+            "0",
+            "points at or below the horizon",
+        ),
+        (
+            ["--light-pos", "0,-0.5,0"],
+            "0",
+            "the light at height -0.5000 is at or below",
+        ),
+    ] {
+        let mut args = vec!["shadows", text(&input), "--ground", ground, "--cpu"];
+        args.extend(light);
+        args.extend(["--grid", "16", "--out", text(&out)]);
+        let (ok, stdout, stderr) = run(&args);
+        assert!(ok, "{light:?}: {stderr}");
+        assert!(stdout.contains("0.00 % shadowed"), "{stdout}");
+        assert!(
+            stdout.contains(why) && stdout.contains("nothing can shadow the ground"),
+            "{light:?}: {stdout}"
+        );
+    }
+    // A light above a mesh above the ground: no note.
+    let (ok, stdout, _) = run(&[
+        "shadows",
+        text(&input),
+        "--ground",
+        "0",
+        "--cpu",
+        "--light-dir",
+        "0,1,0",
+        "--grid",
+        "16",
+        "--out",
+        text(&out),
+    ]);
+    assert!(ok && !stdout.contains("note:"), "{stdout}");
+}
+
+#[test]
 fn bad_flags_are_refused_before_any_output() {
     let dir = tempfile::tempdir().unwrap();
     let input = square(dir.path());
