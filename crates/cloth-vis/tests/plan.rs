@@ -409,3 +409,22 @@ fn bad_shadow_volume_tables_are_named_before_any_work() {
         ]
     );
 }
+
+#[test]
+fn the_output_table_writes_the_images_it_names_and_both_when_it_names_none() {
+    let names = |output: &str| {
+        let s = scene(&format!("{CLOTH}\n{output}"), ".".as_ref());
+        (s.output.png, s.output.exr)
+    };
+    let both = (Some("render.png".to_owned()), Some("render.exr".to_owned()));
+    assert_eq!(names(""), both);
+    assert_eq!(names("[output]\nbackground = \"black\"\n"), both);
+    assert_eq!(
+        names("[output]\npng = \"a.png\"\n"),
+        (Some("a.png".to_owned()), None)
+    );
+    assert_eq!(
+        names("[output]\nexr = \"a.exr\"\n"),
+        (None, Some("a.exr".to_owned()))
+    );
+}

@@ -352,6 +352,7 @@ impl Scene {
         })?;
         scene.base_dir = base_dir.to_owned();
         scene.origin = origin.to_owned();
+        scene.output.name_default_images();
         Ok(scene)
     }
 

@@ -128,11 +128,13 @@ fn default_ground_cells() -> u32 {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputDesc {
-    /// PNG file name (tone-mapped), or omitted for none.
-    #[serde(default = "default_png")]
+    /// PNG file name (tone-mapped). A table that names only `exr` writes no PNG; one that
+    /// names neither writes both defaults, `render.png` and `render.exr`.
+    #[serde(default)]
     pub png: Option<String>,
-    /// EXR file name (linear radiance), or omitted for none.
-    #[serde(default = "default_exr")]
+    /// EXR file name (linear radiance). A table that names only `png` writes no EXR; one that
+    /// names neither writes both defaults.
+    #[serde(default)]
     pub exr: Option<String>,
     /// Exposure multiplier or `"auto"`.
     #[serde(default = "default_exposure")]
@@ -166,6 +168,17 @@ fn default_exposure() -> ExposureDesc {
 }
 fn default_gamma() -> f32 {
     2.2
+}
+
+impl OutputDesc {
+    /// The default names where the table named neither image (a table naming one asked for
+    /// that one only).
+    pub(crate) fn name_default_images(&mut self) {
+        if self.png.is_none() && self.exr.is_none() {
+            self.png = default_png();
+            self.exr = default_exr();
+        }
+    }
 }
 
 impl Default for OutputDesc {
