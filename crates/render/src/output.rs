@@ -25,22 +25,22 @@ impl Background {
     }
 }
 
-/// The objects' luminance: the pixels they cover entirely (alpha 1). Edge pixels are left
-/// out — under MSAA they mix in the backdrop's samples, and a sun behind an edge would set
-/// the exposure. The backdrop never counts.
-pub fn object_luminances(image: &HdrImage) -> impl Iterator<Item = f32> + '_ {
+/// The objects' brightest channel ([`tone::peak`]): the pixels they cover entirely (alpha 1).
+/// Edge pixels are left out — under MSAA they mix in the backdrop's samples, and a sun behind
+/// an edge would set the exposure. The backdrop never counts.
+pub fn object_peaks(image: &HdrImage) -> impl Iterator<Item = f32> + '_ {
     image
         .pixels()
         .iter()
         .filter(|p| p[3] >= 1.0)
-        .map(|p| tone::luminance([p[0], p[1], p[2]]))
+        .map(|p| tone::peak([p[0], p[1], p[2]]))
 }
 
-/// The exposure (EV) that puts the objects' [`tone::AUTO_EXPOSURE_PERCENTILE`] luminance at
-/// [`tone::AUTO_EXPOSURE_KEY`]; 0 when no object is visible.
+/// The exposure (EV) that puts the objects' [`tone::AUTO_EXPOSURE_PERCENTILE`] brightest
+/// channel at [`tone::AUTO_EXPOSURE_KEY`]; 0 when no object is visible.
 pub fn auto_exposure(image: &HdrImage) -> f32 {
     tone::auto_exposure_ev(
-        object_luminances(image),
+        object_peaks(image),
         tone::AUTO_EXPOSURE_PERCENTILE,
         tone::AUTO_EXPOSURE_KEY,
     )
@@ -135,6 +135,22 @@ mod tests {
         assert_eq!(rgba[8], Display::default().map_u8(5.2));
         let opaque = to_rgba8(&image(), &d, Background::Environment);
         assert!(opaque.chunks(4).all(|p| p[3] == 255));
+    }
+
+    #[test]
+    fn auto_exposure_keys_a_saturated_colour_on_its_strongest_channel() {
+        // A red object, albedo (0.9, 0.3, 0.2) under unit light: keyed on its luminance
+        // (0.42) its red channel would land at 1.71 after exposure, deep in the curve's
+        // shoulder, and the picture would show pale pink; keyed on red it lands at 0.8.
+        let red = HdrImage::new(1, 1, vec![[0.9, 0.3, 0.2, 1.0]]).unwrap();
+        let ev = auto_exposure(&red);
+        assert!((ev - (0.8f32 / 0.9).log2()).abs() < 1e-6, "{ev}");
+        let d = Display {
+            exposure_ev: ev,
+            ..Display::default()
+        };
+        let [r, g, b] = [0.9f32, 0.3, 0.2].map(|c| d.map_u8(c));
+        assert!(r > g && g > b && r - b > 60, "{r} {g} {b}");
     }
 
     #[test]

@@ -102,12 +102,20 @@ impl Display {
     }
 }
 
-/// Where automatic exposure puts the chosen percentile of the objects' luminance (after
-/// exposure, before the curve): ACES maps 0.8 to 0.75, bright but clear of the shoulder.
+/// Where automatic exposure puts the chosen percentile of the objects' brightest channel
+/// ([`peak`]; after exposure, before the curve): ACES maps 0.8 to 0.75, bright but clear of
+/// the shoulder — every channel, so a saturated colour keeps its hue.
 pub const AUTO_EXPOSURE_KEY: f32 = 0.8;
 /// The percentile automatic exposure reads: the 90th, so highlights and not the mean decide
 /// (a mostly shadowed object is not pushed into white).
 pub const AUTO_EXPOSURE_PERCENTILE: f64 = 0.9;
+
+/// The brightest of three linear channels: what automatic exposure keys on. Luminance would
+/// let a saturated colour's strongest channel run past the key (red of albedo (0.9, 0.3, 0.2)
+/// sits at 2.1× its luminance) into the curve's shoulder, where the hue washes out.
+pub fn peak(rgb: [f32; 3]) -> f32 {
+    rgb[0].max(rgb[1]).max(rgb[2])
+}
 
 /// The exposure (EV) that puts the `percentile` of `luminances` at `key`; `None` when no
 /// luminance is finite and positive. Non-finite and non-positive values are ignored.

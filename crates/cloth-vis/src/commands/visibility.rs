@@ -36,7 +36,8 @@
 //! - `--render FILE.png|FILE.exr`: the last frame drawn by the shared frame of crate `render` (Gouraud, both
 //!   sides with c_i, the environment as backdrop when one is given) from an automatically
 //!   framed camera; PNG tone-mapped with `2^EV` exposure (default: automatic, the 90th
-//!   percentile of the object's pixel luminance maps to 0.8, the backdrop never counts) and
+//!   percentile of the object's pixels' brightest channel maps to 0.8, the backdrop never
+//!   counts) and
 //!   clamp-then-gamma, EXR linear. Needs a GPU adapter
 //!   (lavapipe is fine).
 
@@ -58,7 +59,8 @@ use glam::Vec3;
 use gpu_context::GpuContext;
 use occlusion_gpu::Backend;
 
-/// Where the colours of `.ply`/`.glb` outputs put the 90th percentile of vertex luminance.
+/// Where the colours of `.ply`/`.glb` outputs put the 90th percentile of the vertices'
+/// brightest channel.
 const AUTO_EXPOSURE_KEY: f32 = render::tone::AUTO_EXPOSURE_KEY;
 /// Default display gamma of `--render` PNGs and of `.ply` colours.
 pub const DEFAULT_GAMMA: f32 = 2.2;
@@ -95,7 +97,7 @@ pub struct VisibilityRequest {
     /// Render the last frame to this `.png` (tone-mapped) or `.exr` (linear) image.
     pub render: Option<PathBuf>,
     /// PNG exposure in stops: the multiplier is 2^EV; `None` = automatic (the 90th percentile
-    /// of the used vertices' luminance maps to 0.8).
+    /// of the pixels' brightest channel maps to 0.8).
     pub exposure_ev: Option<f32>,
     /// PNG display gamma.
     pub gamma: f32,
@@ -543,10 +545,11 @@ pub fn run_visibility(
     })
 }
 
-/// Linear display colours: radiance scaled so that the 90th percentile of luminance is 0.8,
-/// clamped to [0, 1]; black for non-finite radiance (unused vertices).
+/// Linear display colours: radiance scaled so that the 90th percentile of the brightest
+/// channel is 0.8 (as the pictures' automatic exposure), clamped to [0, 1]; black for
+/// non-finite radiance (unused vertices).
 pub(super) fn linear_display_colours(c: &[Vec3]) -> Vec<Vec3> {
-    let lum = c.iter().map(|v| render::tone::luminance(v.to_array()));
+    let lum = c.iter().map(|v| render::tone::peak(v.to_array()));
     let scale = render::tone::auto_exposure_ev(
         lum,
         render::tone::AUTO_EXPOSURE_PERCENTILE,
@@ -564,7 +567,8 @@ pub(super) fn linear_display_colours(c: &[Vec3]) -> Vec<Vec3> {
         .collect()
 }
 
-/// Map radiance to display colours: the 90th percentile of luminance to 0.8, gamma 2.2.
+/// Map radiance to display colours: the 90th percentile of the brightest channel to 0.8,
+/// gamma 2.2.
 pub(super) fn display_colours(c: &[Vec3]) -> Vec<Vec3> {
     linear_display_colours(c)
         .into_iter()
@@ -689,7 +693,7 @@ pub struct VisibilityArgs {
     #[arg(long, value_name = "FILE")]
     render: Option<PathBuf>,
     /// PNG exposure in stops (multiplier 2^EV); default: auto (the 90th percentile of the
-    /// object's pixel luminance maps to 0.8).
+    /// object's pixels' brightest channel maps to 0.8).
     #[arg(long, value_name = "EV", allow_negative_numbers = true)]
     exposure: Option<f32>,
     /// PNG display gamma.

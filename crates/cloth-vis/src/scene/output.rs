@@ -4,7 +4,8 @@
 use serde::Deserialize;
 
 /// Exposure: stops (EV; radiance is multiplied by 2^EV before the tone curve), or `"auto"`
-/// (the 90th percentile of the objects' pixel luminance — never the backdrop's — maps to 0.8).
+/// (the 90th percentile of the objects' pixels' brightest channel — never the backdrop's —
+/// maps to 0.8, so a saturated colour keeps its hue).
 #[derive(Clone, Copy, Debug, PartialEq, Deserialize, serde::Serialize)]
 #[serde(untagged)]
 pub enum ExposureDesc {
