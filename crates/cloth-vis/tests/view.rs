@@ -469,6 +469,11 @@ fn a_turned_sky_relights_the_btf_through_the_same_visibility() {
 
 /// A scene of one clip file (relative to the scene), explicit camera on the chicken.
 fn clip_scene(source: &str, frame: usize) -> String {
+    placed_clip_scene(source, frame, "")
+}
+
+/// [`clip_scene`] with more keys of the object (`translation = …`).
+fn placed_clip_scene(source: &str, frame: usize, placement: &str) -> String {
     format!(
         r#"
 effects = ["lighting", "self-shadowing"]
@@ -478,6 +483,7 @@ name = "clip"
 source = "{source}"
 frame = {frame}
 two_sided = true
+{placement}
 
 [environment]
 source = "synth:sky"
@@ -538,6 +544,22 @@ fn a_cpca_streams_through_the_gpu_decoder_with_its_own_visibility() {
     // Playing advances one decoded frame per presented frame.
     let (_, stdout) = scripted(dir.path(), &scene, "play", "play\n");
     assert!(stdout.contains("cpca frame 1 of 170"), "{stdout}");
+    // A placed object: the decoded poses land where the loaded frame did (they were drawn
+    // without the object's transform, so a moved .cpca left the picture).
+    let moved = "translation = [0.4, 0.2, -0.3]";
+    let (scene, _) = render_still(
+        dir.path(),
+        "moved",
+        &placed_clip_scene("chicken.cpca", 0, moved),
+    );
+    let (_, moved_later) = render_still(
+        dir.path(),
+        "moved-later",
+        &placed_clip_scene("chicken.cpca", 90, moved),
+    );
+    let (shot, _) = scripted(dir.path(), &scene, "moved-seek", "frame 90\n");
+    assert_matches(&shot, &moved_later, "the moved still of frame 90");
+    assert_differs(&shot, &later, 1.0, "the moved frame 90 looks unmoved");
 }
 
 #[test]

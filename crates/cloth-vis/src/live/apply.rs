@@ -115,10 +115,15 @@ impl LiveScene {
                 positions.len()
             ));
         }
-        let world = object
-            .animation
-            .as_ref()
-            .map_or(glam::Mat4::IDENTITY, |a| a.world_from_object);
+        // A clip's own transform; a `.cpca` object is loaded as one decoded frame and holds
+        // none, so its scene entry's (the pose must land where the loaded frame did).
+        let world = match &object.animation {
+            Some(a) => a.world_from_object,
+            None => self.scene.objects.get(index).map_or(
+                glam::Mat4::IDENTITY,
+                crate::scene::ObjectDesc::world_from_object,
+            ),
+        };
         object.pose_positions(positions, world);
         self.pose_id += 1;
         Ok(())
