@@ -31,6 +31,26 @@ pub enum SourceFormat {
     Mdd,
 }
 
+/// For reports: `binary little-endian PLY`, `OBJ`, `a folder of OBJ frames`, `glTF binary`,
+/// `PC2 point cache`, …
+impl std::fmt::Display for SourceFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SourceFormat::Unknown => "unknown format",
+            SourceFormat::PlyAscii => "ascii PLY",
+            SourceFormat::PlyBinaryLittleEndian => "binary little-endian PLY",
+            SourceFormat::PlyBinaryBigEndian => "binary big-endian PLY",
+            SourceFormat::Obj => "OBJ",
+            SourceFormat::ObjFrames => "a folder of OBJ frames",
+            SourceFormat::Gltf => "glTF JSON",
+            SourceFormat::Glb => "glTF binary",
+            SourceFormat::Npy => "NumPy .npy",
+            SourceFormat::Pc2 => "PC2 point cache",
+            SourceFormat::Mdd => "MDD point cache",
+        })
+    }
+}
+
 /// Why a triangle is degenerate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DegenerateKind {

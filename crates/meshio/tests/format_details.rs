@@ -114,3 +114,19 @@ fn obj_per_corner_attributes_kept_when_consistent_dropped_at_seams() {
     );
     assert_eq!(AttributeStatus::Absent.to_string(), "none in the file");
 }
+
+#[test]
+fn formats_read_as_words_in_reports() {
+    use meshio::SourceFormat;
+    assert_eq!(SourceFormat::PlyAscii.to_string(), "ascii PLY");
+    assert_eq!(
+        SourceFormat::PlyBinaryBigEndian.to_string(),
+        "binary big-endian PLY"
+    );
+    assert_eq!(
+        SourceFormat::ObjFrames.to_string(),
+        "a folder of OBJ frames"
+    );
+    assert_eq!(SourceFormat::Glb.to_string(), "glTF binary");
+    assert_eq!(SourceFormat::Pc2.to_string(), "PC2 point cache");
+}

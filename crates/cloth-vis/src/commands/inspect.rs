@@ -54,7 +54,7 @@ impl InspectArgs {
             let (anim, report) = meshio::load_animation(input, &options)?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
             let mut lines = vec![format!(
-                "{}: animation ({:?}), {} frames x {} vertices, {} triangles, {:.1} fps ({:.2} s), \
+                "{}: animation ({}), {} frames x {} vertices, {} triangles, {:.1} fps ({:.2} s), \
                  loaded in {ms:.1} ms",
                 input.display(),
                 report.format,
@@ -103,7 +103,7 @@ impl InspectArgs {
             let (lo, hi) = bounds(mesh.positions.iter());
             let mut lines = vec![
                 format!(
-                    "{}: mesh ({:?}), {} vertices, {} triangles, loaded in {ms:.1} ms",
+                    "{}: mesh ({}), {} vertices, {} triangles, loaded in {ms:.1} ms",
                     input.display(),
                     report.format,
                     mesh.vertex_count(),

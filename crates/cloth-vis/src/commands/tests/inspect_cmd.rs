@@ -16,7 +16,7 @@ fn inspect_summarises_a_mesh_and_an_animation() {
     let out = cli(&["inspect", text(&obj)]);
     assert!(out.status.success(), "{out:?}");
     let s = String::from_utf8(out.stdout).unwrap();
-    assert!(s.contains("mesh (Obj), 5 vertices, 3 triangles"), "{s}");
+    assert!(s.contains("mesh (OBJ), 5 vertices, 3 triangles"), "{s}");
     assert!(
         s.contains("extent: (0.0000, 0.0000, 0.0000) .. (5.0000, 5.0000, 5.0000)"),
         "{s}"
@@ -46,7 +46,7 @@ fn inspect_summarises_a_mesh_and_an_animation() {
     assert!(out.status.success(), "{out:?}");
     let s = String::from_utf8(out.stdout).unwrap();
     assert!(
-        s.contains("animation (ObjFrames), 2 frames x 3 vertices, 1 triangles"),
+        s.contains("animation (a folder of OBJ frames), 2 frames x 3 vertices, 1 triangles"),
         "{s}"
     );
     assert!(
