@@ -117,14 +117,15 @@ pub fn peak(rgb: [f32; 3]) -> f32 {
     rgb[0].max(rgb[1]).max(rgb[2])
 }
 
-/// The exposure (EV) that puts the `percentile` of `luminances` at `key`; `None` when no
-/// luminance is finite and positive. Non-finite and non-positive values are ignored.
+/// The exposure (EV) that puts the `percentile` of `levels` (per-pixel [`peak`]s, as
+/// [`crate::output::auto_exposure`] passes them) at `key`; `None` when no level is finite and
+/// positive. Non-finite and non-positive values are ignored.
 pub fn auto_exposure_ev(
-    luminances: impl IntoIterator<Item = f32>,
+    levels: impl IntoIterator<Item = f32>,
     percentile: f64,
     key: f32,
 ) -> Option<f32> {
-    let mut lum: Vec<f32> = luminances
+    let mut lum: Vec<f32> = levels
         .into_iter()
         .filter(|l| l.is_finite() && *l > 0.0)
         .collect();

@@ -549,9 +549,9 @@ pub fn run_visibility(
 /// channel is 0.8 (as the pictures' automatic exposure), clamped to [0, 1]; black for
 /// non-finite radiance (unused vertices).
 pub(super) fn linear_display_colours(c: &[Vec3]) -> Vec<Vec3> {
-    let lum = c.iter().map(|v| render::tone::peak(v.to_array()));
+    let peaks = c.iter().map(|v| render::tone::peak(v.to_array()));
     let scale = render::tone::auto_exposure_ev(
-        lum,
+        peaks,
         render::tone::AUTO_EXPOSURE_PERCENTILE,
         AUTO_EXPOSURE_KEY,
     )
