@@ -266,6 +266,40 @@ fn an_animation_frame_is_lit_through_its_own_visibility() {
     assert_differs(&shot, &last, 2.0, "frame 12 looks like the last frame");
 }
 
+/// An event that parses but cannot apply to the scene (a map index past the choices) ends the
+/// replay with an error that quotes it as its line in the file.
+#[test]
+fn a_failing_event_is_quoted_as_written() {
+    if !ready() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, scene_text(SHADOWED, -1, EYE)).unwrap();
+    let script = dir.path().join("events.txt");
+    std::fs::write(&script, "orbit 10 0\nenvironment 3\n").unwrap();
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 800x600x24"])
+        .arg(env!("CARGO_BIN_EXE_cloth-vis"))
+        .args([
+            "view",
+            text(&scene),
+            "--frames",
+            "3",
+            "--events",
+            text(&script),
+        ])
+        .args(["--size", "160x120"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("event 2 (`environment 3`): environment 3 does not exist"),
+        "{stderr}"
+    );
+}
+
 #[test]
 fn no_display_is_refused_before_any_work() {
     let out = Command::new(env!("CARGO_BIN_EXE_cloth-vis"))

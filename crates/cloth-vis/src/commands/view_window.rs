@@ -280,7 +280,7 @@ impl App {
         let index = self.presented as usize;
         if let Some(&event) = self.request.events.get(index) {
             self.apply(event)
-                .map_err(|m| anyhow::anyhow!("event {} ({event:?}): {m}", index + 1))?;
+                .map_err(|m| anyhow::anyhow!("event {} (`{event}`): {m}", index + 1))?;
         } else if self.playing {
             self.advance(1).map_err(|m| anyhow::anyhow!("{m}"))?;
         }

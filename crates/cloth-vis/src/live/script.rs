@@ -74,6 +74,51 @@ pub enum ViewEvent {
     Pause,
 }
 
+/// The event as a line of an events file: `parse_events` reads it back as the same event
+/// (a clamp curve as `tone clamp`, the only gamma a file can name).
+impl std::fmt::Display for ViewEvent {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use crate::scene::VisibilityBackendDesc as B;
+        use render::tone::ToneCurve;
+        match *self {
+            Self::Orbit(yaw, pitch) => write!(f, "orbit {yaw} {pitch}"),
+            Self::Pan(x, y) => write!(f, "pan {x} {y}"),
+            Self::Zoom(factor) => write!(f, "zoom {factor}"),
+            Self::Home => f.write_str("home"),
+            Self::Toggle(effect) => write!(f, "toggle {effect}"),
+            Self::Set(effect, on) => write!(f, "{} {effect}", if on { "on" } else { "off" }),
+            Self::Level(level) => write!(f, "level {level}"),
+            Self::Rotation(degrees) => write!(f, "rotation {degrees}"),
+            Self::Environment(i) => write!(f, "environment {i}"),
+            Self::Tone(curve) => f.write_str(match curve {
+                ToneCurve::AcesFitted => "tone aces",
+                ToneCurve::Clamp { .. } => "tone clamp",
+                ToneCurve::ClampSrgb => "tone srgb",
+            }),
+            Self::PointLight(p) => write!(f, "light {} {} {}", p.x, p.y, p.z),
+            Self::Backend(backend, side) => {
+                let name = match backend {
+                    B::Auto => "auto",
+                    B::Cpu => "cpu",
+                    B::Depth => "depth",
+                    B::Query => "query",
+                };
+                match side {
+                    Some(side) => write!(f, "backend {name} {side}"),
+                    None => write!(f, "backend {name}"),
+                }
+            }
+            Self::Exposure(Some(ev)) => write!(f, "exposure {ev}"),
+            Self::Exposure(None) => f.write_str("exposure auto"),
+            Self::Frame(frame) => write!(f, "frame {frame}"),
+            Self::BtfPlain(on) => write!(f, "btf-plain {}", if on { "on" } else { "off" }),
+            Self::Play => f.write_str("play"),
+            Self::NextCell => f.write_str("next-cell"),
+            Self::Pause => f.write_str("pause"),
+        }
+    }
+}
+
 /// Read and parse an events file (a regular file, at most [`MAX_EVENTS`] events).
 ///
 /// # Errors
@@ -299,6 +344,21 @@ mod tests {
                 ViewEvent::Tone(render::tone::ToneCurve::ClampSrgb),
             ]
         );
+    }
+
+    /// Every event prints as the line that parses back to it (the viewer's errors quote
+    /// events this way).
+    #[test]
+    fn every_event_prints_as_its_line() {
+        let text = "orbit 90.5 -10\npan 0.1 0\nzoom 0.5\nhome\ntoggle self-shadowing\n\
+                    off shadow-volumes\non btf\nlevel 2\nrotation 45\nexposure -1.25\n\
+                    exposure auto\nframe 7\nbtf-plain on\nbtf-plain off\nplay\npause\n\
+                    next-cell\nlight 0 3 -2.5\nbackend depth 512\nbackend cpu\nbackend auto\n\
+                    backend query\nenvironment 2\ntone srgb\ntone aces\ntone clamp\n";
+        let events = parse_events(text).unwrap();
+        let printed: Vec<String> = events.iter().map(ToString::to_string).collect();
+        assert_eq!(printed, text.lines().collect::<Vec<_>>());
+        assert_eq!(parse_events(&printed.join("\n")).unwrap(), events);
     }
 
     #[test]
