@@ -54,13 +54,12 @@ impl InspectArgs {
             let (anim, report) = meshio::load_animation(input, &options)?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
             let mut lines = vec![format!(
-                "{}: animation ({}), {} frames x {} vertices, {} triangles, {:.1} fps ({:.2} s), \
-                 loaded in {ms:.1} ms",
+                "{}: animation ({}), {} x {}, {}, {:.1} fps ({:.2} s), loaded in {ms:.1} ms",
                 input.display(),
                 report.format,
-                anim.frame_count(),
-                anim.vertex_count(),
-                anim.triangles.len(),
+                counted(anim.frame_count(), "frame"),
+                counted(anim.vertex_count(), "vertex"),
+                counted(anim.triangles.len(), "triangle"),
                 anim.frame_rate,
                 anim.frame_count() as f64 / f64::from(anim.frame_rate)
             )];
@@ -103,11 +102,11 @@ impl InspectArgs {
             let (lo, hi) = bounds(mesh.positions.iter());
             let mut lines = vec![
                 format!(
-                    "{}: mesh ({}), {} vertices, {} triangles, loaded in {ms:.1} ms",
+                    "{}: mesh ({}), {}, {}, loaded in {ms:.1} ms",
                     input.display(),
                     report.format,
-                    mesh.vertex_count(),
-                    mesh.triangle_count()
+                    counted(mesh.vertex_count(), "vertex"),
+                    counted(mesh.triangle_count(), "triangle")
                 ),
                 format!(
                     "extent: {} .. {} (diagonal {:.4})",
@@ -160,20 +159,21 @@ fn report_lines(report: &LoadReport) -> Vec<String> {
         status(&report.uvs)
     )];
     lines.push(format!(
-        "as written: {} vertices, {} faces ({} triangles, {} polygons fan-triangulated); \
+        "as written: {}, {} ({}, {} fan-triangulated); \
          unreferenced vertices: {}, degenerate triangles: {}, duplicate positions: {}",
-        report.file_vertex_count,
-        report.file_face_count,
-        report.file_triangle_count,
-        report.polygons_triangulated,
+        counted(report.file_vertex_count, "vertex"),
+        counted(report.file_face_count, "face"),
+        counted(report.file_triangle_count, "triangle"),
+        counted(report.polygons_triangulated, "polygon"),
         report.unreferenced_vertices.len(),
         report.degenerate_triangles.len(),
         report.duplicate_positions
     ));
     if report.removed_triangles + report.removed_vertices > 0 {
         lines.push(format!(
-            "removed: {} triangles, {} vertices",
-            report.removed_triangles, report.removed_vertices
+            "removed: {}, {}",
+            counted(report.removed_triangles, "triangle"),
+            counted(report.removed_vertices, "vertex")
         ));
     }
     if report.topology_missing {
@@ -215,4 +215,13 @@ fn max_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
 
 fn fmt3(v: Vec3) -> String {
     format!("({:.4}, {:.4}, {:.4})", v.x, v.y, v.z)
+}
+
+/// `n` and the noun, plural unless n is 1: "1 triangle", "3 vertices".
+fn counted(n: usize, noun: &str) -> String {
+    match (n, noun) {
+        (1, _) => format!("1 {noun}"),
+        (_, "vertex") => format!("{n} vertices"),
+        _ => format!("{n} {noun}s"),
+    }
 }

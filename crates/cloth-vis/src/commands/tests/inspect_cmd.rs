@@ -21,7 +21,10 @@ fn inspect_summarises_a_mesh_and_an_animation() {
         s.contains("extent: (0.0000, 0.0000, 0.0000) .. (5.0000, 5.0000, 5.0000)"),
         "{s}"
     );
-    assert!(s.contains("1 polygons fan-triangulated"), "{s}");
+    assert!(
+        s.contains("2 faces (3 triangles, 1 polygon fan-triangulated)"),
+        "{s}"
+    );
     assert!(s.contains("unreferenced vertices: 1"), "{s}");
     assert!(s.contains("skipped keywords: o ×1"), "{s}");
     assert!(!s.contains("LoadReport {"), "{s}");
@@ -46,7 +49,7 @@ fn inspect_summarises_a_mesh_and_an_animation() {
     assert!(out.status.success(), "{out:?}");
     let s = String::from_utf8(out.stdout).unwrap();
     assert!(
-        s.contains("animation (a folder of OBJ frames), 2 frames x 3 vertices, 1 triangles"),
+        s.contains("animation (a folder of OBJ frames), 2 frames x 3 vertices, 1 triangle,"),
         "{s}"
     );
     assert!(
