@@ -137,3 +137,60 @@ fn quiet_headless_device_select() {
         std::env::set_var("NODEVICE_SELECT", "1");
     }
 }
+
+#[cfg(test)]
+mod cli_tests {
+    use clap::CommandFactory;
+
+    use super::Cli;
+
+    /// Every subcommand, depth first, with its path of names.
+    fn walk(command: &clap::Command, path: String, out: &mut Vec<(String, clap::Command)>) {
+        for sub in command.get_subcommands() {
+            let name = format!("{path} {}", sub.get_name());
+            out.push((name.clone(), sub.clone()));
+            walk(sub, name, out);
+        }
+    }
+
+    /// clap's own consistency checks (no two arguments share a flag or a short), and `-o`
+    /// for `--out` wherever a command writes to `--out`: the habit of every compiler and
+    /// converter a user comes from.
+    #[test]
+    fn every_out_flag_has_the_short_o() {
+        Cli::command().debug_assert();
+        let mut all = Vec::new();
+        walk(&Cli::command(), "cloth-vis".to_owned(), &mut all);
+        let mut outs = 0;
+        for (name, command) in &all {
+            for arg in command.get_arguments() {
+                if arg.get_long() == Some("out") {
+                    outs += 1;
+                    assert_eq!(arg.get_short(), Some('o'), "{name} --out");
+                } else {
+                    assert_ne!(arg.get_short(), Some('o'), "{name}: -o is not --out");
+                }
+            }
+        }
+        assert!(outs >= 16, "{outs} --out flags");
+    }
+
+    /// `-o FILE` parses as `--out FILE`, in a command and in a nested one.
+    #[test]
+    fn dash_o_is_out() {
+        for args in [
+            &["visibility", "bunny.ply", "-o", "ao.npy"][..],
+            &["anim", "decompress", "clip.cpca", "-o", "ao.npy"],
+        ] {
+            let matches = Cli::command()
+                .try_get_matches_from(std::iter::once("cloth-vis").chain(args.iter().copied()))
+                .unwrap_or_else(|e| panic!("{args:?}: {e}"));
+            let mut sub = matches.subcommand().unwrap().1;
+            while let Some((_, deeper)) = sub.subcommand() {
+                sub = deeper;
+            }
+            let out = sub.get_one::<std::path::PathBuf>("out");
+            assert_eq!(out, Some(&std::path::PathBuf::from("ao.npy")), "{args:?}");
+        }
+    }
+}

@@ -78,7 +78,7 @@ pub struct BakeArgs {
     /// Output: .glb (or .gltf + .bin beside it) for a glTF input, .obj for an OBJ, .ply for a
     /// PLY; .exr/.png for a vertex-animation texture of an animation with a_i per frame in
     /// alpha.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Lightsphere level s (k = 2 + 4^(s+1) directions), as for `visibility`.
     #[arg(long, default_value_t = 3)]

@@ -368,7 +368,7 @@ pub struct SynthArgs {
     #[arg(long, default_value_t = synth::WovenBtfParams::default().supersample)]
     supersample: usize,
     /// Output folder (must not exist, or be empty; created with its parents).
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Replace an output folder that already holds files, once the new one is complete.
     #[arg(long)]
@@ -393,7 +393,7 @@ pub struct CompressArgs {
     #[arg(long, default_value = "u16", value_parser = parse_storage)]
     mean_storage: btf::Storage,
     /// Output: FILE.btfpca.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Hide the progress bar.
     #[arg(long)]

@@ -220,7 +220,7 @@ pub struct FinSynthArgs {
     #[arg(long, default_value_t = synth::fins::WoolFinParams::default().seed)]
     seed: u64,
     /// Output folder (must not exist, or be empty).
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Replace an output folder that already holds files, once the new one is complete.
     #[arg(long)]
@@ -245,6 +245,6 @@ pub struct FinCompressArgs {
     #[arg(long, default_value = "u16", value_parser = super::btf::parse_storage)]
     mean_storage: btf::Storage,
     /// Output: FILE.finpca.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
 }

@@ -626,7 +626,7 @@ pub struct RenderArgs {
     #[arg(long = "part", value_name = "NAME=FILE.btfpca", value_parser = super::parse::named_path, conflicts_with_all = ["frames", "fins", "beside_plain", "cpu"])]
     parts: Vec<(String, PathBuf)>,
     /// Output: IMAGE.png (a folder with --frames).
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
 }
 

@@ -512,7 +512,7 @@ pub struct CompressArgs {
     #[arg(long, default_value_t = RdLimits::default().max_cost)]
     max_cost: f64,
     /// Output: FILE.cpca.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Hide the progress spinner.
     #[arg(long)]

@@ -223,7 +223,7 @@ pub struct DecompressArgs {
     input: PathBuf,
     /// Output: FILE.npy, FILE.glb, FILE.exr/FILE.png (a vertex-animation texture) or a folder
     /// name (OBJ frames).
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Replace an existing output folder that holds files, once the new frames are complete;
     /// write an output estimated above 8 GiB.

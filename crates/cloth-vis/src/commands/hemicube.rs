@@ -533,7 +533,7 @@ pub struct HemicubeArgs {
     #[arg(long, default_value = "map", value_parser = ["map", "ray"])]
     light_test: String,
     /// Output: .npy, .ply or .glb.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: Option<PathBuf>,
     /// Render FILE.png (tone-mapped) or FILE.exr (linear). Needs a GPU adapter.
     #[arg(long, value_name = "FILE")]

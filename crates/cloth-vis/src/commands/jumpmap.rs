@@ -694,7 +694,7 @@ pub struct JumpmapArgs {
     #[arg(long, default_value_t = 0)]
     seed: u64,
     /// Output: FILE.npy, FILE.glb or a folder name (OBJ frames).
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Replace an existing output folder that holds files, once the new frames are complete;
     /// write an output estimated above 8 GiB.

@@ -14,7 +14,7 @@ pub struct RenderArgs {
     scene: PathBuf,
     /// Output folder (created with its parents; built beside and renamed into place when
     /// complete).
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Replace an output folder that already holds files, once the new one is complete.
     #[arg(long)]
@@ -49,7 +49,7 @@ impl RenderArgs {
 pub struct DemoArgs {
     /// Output folder (created with its parents; built beside and renamed into place when
     /// complete).
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Replace an output folder that already holds files, once the new one is complete.
     #[arg(long)]

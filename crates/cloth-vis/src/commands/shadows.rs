@@ -80,7 +80,7 @@ pub struct ShadowsArgs {
     #[arg(long)]
     cpu: bool,
     /// The mask, f32 [N, N] (.npy).
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Also draw the mesh over the ground, lit and shadowed (.png tone-mapped, .exr linear).
     #[arg(long, value_name = "FILE")]

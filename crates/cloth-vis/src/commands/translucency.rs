@@ -41,7 +41,7 @@ pub struct ShArgs {
     /// E_lm as f32 [9, 3] (.npy): row k = l(l+1)+m in R&H's order (Y00, Y1−1 ∝ y, Y10 ∝ z,
     /// Y11 ∝ x, Y2−2 ∝ xy, Y2−1 ∝ yz, Y20 ∝ 3z²−1, Y21 ∝ xz, Y22 ∝ x²−y²), columns R, G, B;
     /// windowed when a window is given.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
 }
 
@@ -175,7 +175,7 @@ pub struct TranslucencyArgs {
     #[arg(long, value_name = "A..B")]
     frames: Option<FrameRange>,
     /// An image (.png tone-mapped, .exr linear), or a folder with --frames.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: PathBuf,
     /// Replace an output folder that already holds files, once the new one is complete.
     #[arg(long)]

@@ -678,7 +678,7 @@ pub struct VisibilityArgs {
     /// `ao` = a_i, NaN for unused vertices) or .glb (one frame: linear float COLOR_0, float
     /// `_AO` = a_i, -1 for unused vertices). Unused: without a normal, because no triangle
     /// (or only degenerate ones) uses them — the Stanford bunny has 1,113.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     out: Option<PathBuf>,
     /// Write the matrix M (M_ij = n_i·l_j where vertex i sees direction j, else 0) instead of
     /// a_i (.npy only), with STEM.directions.npy (l_j, f32 [k, 3], world +Y up) and
