@@ -68,14 +68,20 @@ fn xvfb() -> bool {
     test_data::skip::<()>("xvfb-run is not installed (apt-get install xvfb)").is_some()
 }
 
-fn view(args: &[&str]) -> Output {
-    let out = Command::new("xvfb-run")
+/// `cloth-vis view ARGS` under Xvfb, whatever its exit.
+fn view_output(args: &[&str]) -> Output {
+    Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 800x600x24"])
         .arg(env!("CARGO_BIN_EXE_cloth-vis"))
         .arg("view")
         .args(args)
         .output()
-        .unwrap();
+        .unwrap()
+}
+
+/// `cloth-vis view ARGS` under Xvfb, which must succeed.
+fn view(args: &[&str]) -> Output {
+    let out = view_output(args);
     assert!(
         out.status.success(),
         "view {args:?} failed: {}\n{}",
@@ -278,20 +284,15 @@ fn a_failing_event_is_quoted_as_written() {
     std::fs::write(&scene, scene_text(SHADOWED, -1, EYE)).unwrap();
     let script = dir.path().join("events.txt");
     std::fs::write(&script, "orbit 10 0\nenvironment 3\n").unwrap();
-    let out = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 800x600x24"])
-        .arg(env!("CARGO_BIN_EXE_cloth-vis"))
-        .args([
-            "view",
-            text(&scene),
-            "--frames",
-            "3",
-            "--events",
-            text(&script),
-        ])
-        .args(["--size", "160x120"])
-        .output()
-        .unwrap();
+    let out = view_output(&[
+        text(&scene),
+        "--frames",
+        "3",
+        "--events",
+        text(&script),
+        "--size",
+        "160x120",
+    ]);
     assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
