@@ -23,7 +23,8 @@
 //! same signals; an existing folder that holds files is refused unless the caller replaces it
 //! ([`ExistingFolder`]).
 //!
-//! [`write_with`] hands the caller a buffered writer; [`write_bytes`] writes a slice;
+//! [`check_writable`] tells a command, before its work, whether a write of a path could start
+//! and end, leaving nothing behind. [`write_with`] hands the caller a buffered writer; [`write_bytes`] writes a slice;
 //! [`write_via_path`] is for encoders that insist on opening a path themselves (the `image`
 //! crate's `save`, `exr`'s `to_file`). Errors are [`WriteError`] (which step failed, on which
 //! target) or, for [`write_via_path`], [`AtomicError`], which also carries the encoder's own
@@ -53,4 +54,4 @@ pub use error::{AtomicError, SignalError, WriteError};
 pub use folder::{ExistingFolder, write_dir};
 pub use signal::remove_temporaries_on_signal;
 pub use temporary::registered_temporaries;
-pub use write::{write_bytes, write_via_path, write_with};
+pub use write::{check_writable, write_bytes, write_via_path, write_with};

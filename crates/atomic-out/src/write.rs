@@ -126,6 +126,49 @@ pub fn write_via_path<E>(
     Ok(())
 }
 
+/// Checks, before a long computation, that a write of `path` could start and end: no folder
+/// stands at `path`, its missing parent folders can be created, and a temporary file can be
+/// created beside it. Whatever the check creates it removes again (the file system is left as
+/// it was), so a command can refuse an output it could not write in its first millisecond
+/// rather than after minutes of work. A later write can still fail (a full disk, a folder
+/// created meanwhile): the write reports that itself.
+///
+/// # Errors
+/// [`WriteError`] as [`write_with`] would report it: `"create the folders of"`, `"create"`
+/// (a parent that is read-only, a file system that does not take new files), or
+/// `"replace"` with [`std::io::ErrorKind::IsADirectory`] when `path` is a folder.
+///
+/// # Examples
+/// ```
+/// let dir = tempfile::tempdir()?;
+/// atomic_out::check_writable(&dir.path().join("renders/a.png"))?;
+/// // Nothing was left behind: not the temporary file, not the `renders` folder.
+/// assert_eq!(std::fs::read_dir(dir.path())?.count(), 0);
+/// let err = atomic_out::check_writable(dir.path()).unwrap_err();
+/// assert_eq!(err.op, "replace");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn check_writable(path: &Path) -> Result<(), WriteError> {
+    if std::fs::metadata(path).is_ok_and(|m| m.is_dir()) {
+        return Err(WriteError::new(
+            path,
+            "replace",
+            std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "it is a folder; give a file name",
+            ),
+        ));
+    }
+    let fail = |op| move |e| WriteError::new(path, op, e);
+    let parents = CreatedParents::create(path).map_err(fail("create the folders of"))?;
+    let (temporary, file) = Temporary::create(path).map_err(fail("create"))?;
+    // Dropped in this order: the file closed, the temporary removed, then its new folders.
+    drop(file);
+    drop(temporary);
+    drop(parents);
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

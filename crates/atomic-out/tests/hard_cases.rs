@@ -10,8 +10,8 @@ use std::sync::{Arc, Barrier, mpsc};
 use std::time::{Duration, Instant};
 
 use atomic_out::{
-    AtomicError, ExistingFolder, WriteError, registered_temporaries, remove_temporaries_on_signal,
-    write_bytes, write_dir, write_via_path, write_with,
+    AtomicError, ExistingFolder, WriteError, check_writable, registered_temporaries,
+    remove_temporaries_on_signal, write_bytes, write_dir, write_via_path, write_with,
 };
 
 /// How long the signal test waits for its child process at each step before failing (it takes
@@ -82,6 +82,46 @@ fn missing_folders_are_created_and_a_file_in_their_place_is_an_error_naming_the_
         "{message}"
     );
     assert_eq!(entries(dir.path()), ["renders", "taken"]);
+}
+
+/// The check a command makes before its work refuses what the write would refuse, with the
+/// write's step, and leaves nothing behind whether it passes or not.
+#[test]
+fn check_writable_refuses_what_a_write_would_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    // Missing folders: they could be created, and are removed again.
+    check_writable(&dir.path().join("renders/a/out.npy")).unwrap();
+    assert!(entries(dir.path()).is_empty(), "{:?}", entries(dir.path()));
+    // An existing file: it could be replaced, and is not touched.
+    let kept = dir.path().join("kept.npy");
+    std::fs::write(&kept, b"old").unwrap();
+    check_writable(&kept).unwrap();
+    assert_eq!(std::fs::read(&kept).unwrap(), b"old");
+    // A folder at the target: refused before any temporary, the folder untouched.
+    let folder = dir.path().join("frame.png");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::write(folder.join("inside"), b"kept").unwrap();
+    let err = check_writable(&folder).unwrap_err();
+    assert_eq!(
+        (err.op, err.source.kind()),
+        ("replace", std::io::ErrorKind::IsADirectory)
+    );
+    assert_eq!(entries(&folder), ["inside"]);
+    // A file where a folder should be: the write's own error.
+    let err = check_writable(&kept.join("b.npy")).unwrap_err();
+    assert_eq!(err.op, "create the folders of");
+    // A file system that takes no new files (a path under /proc): the write's "create".
+    #[cfg(target_os = "linux")]
+    {
+        let err = check_writable(Path::new("/proc/cloth-vis-check.npy")).unwrap_err();
+        assert_eq!(err.op, "create");
+        assert!(
+            err.to_string()
+                .starts_with("cannot create /proc/cloth-vis-check.npy: ")
+        );
+    }
+    assert_eq!(entries(dir.path()), ["frame.png", "kept.npy"]);
+    assert!(registered_in(dir.path()).is_empty());
 }
 
 #[test]

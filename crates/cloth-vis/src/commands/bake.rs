@@ -194,7 +194,7 @@ fn kind_of(path: &Path, what: &str) -> Result<Kind, Error> {
 /// whose kind does not match the input's, an output equal to the input, a bad distance.
 pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
     let input = &args.input;
-    super::refuse_overwriting_input(&args.out, &[input])?;
+    super::check_output_file(&args.out, &[input])?;
     let vat = super::vat_out::is_vat(&args.out);
     let kind = if vat {
         Kind::Vat
@@ -219,7 +219,7 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
     }
     if out_extension.as_deref() == Some("gltf") {
         // Its buffer file beside it must not be the input either.
-        super::refuse_overwriting_input(&meshio::text_gltf_buffer(&args.out), &[input])?;
+        super::check_output_file(&meshio::text_gltf_buffer(&args.out), &[input])?;
     }
     if args.back_side && kind != Kind::Gltf {
         return Err(invalid(
@@ -230,7 +230,7 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         ));
     }
     if let Some(path) = &args.per_face {
-        super::refuse_overwriting_input(path, &[input])?;
+        super::check_output_file(path, &[input])?;
         if vat || lower_extension(path).as_deref() != Some("npy") {
             return Err(invalid(
                 path,

@@ -211,14 +211,14 @@ fn check_btfpca_out(out: &Path) -> Result<(), Error> {
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("btfpca"));
-    if ok {
-        Ok(())
-    } else {
-        Err(request(
+    if !ok {
+        return Err(request(
             out,
             "the compressed BTF is written as .btfpca; name the output so".to_owned(),
-        ))
+        ));
     }
+    atomic_out::check_writable(out)?;
+    Ok(())
 }
 
 /// Runs `btf compress`.

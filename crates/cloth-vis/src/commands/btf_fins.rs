@@ -140,6 +140,7 @@ pub fn run_compress(
             "the compressed fin BTF is written as .finpca; name the output so".to_owned(),
         ));
     }
+    atomic_out::check_writable(out)?;
     if params.components == 0 || params.components > DIRECTIONS {
         return Err(request(
             out,

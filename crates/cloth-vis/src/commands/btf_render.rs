@@ -238,6 +238,9 @@ pub fn run_render(
             "the image is written as .png".to_owned(),
         ));
     }
+    if request_.frames.is_none() {
+        super::check_output_file(&request_.out, &[&request_.btf, &request_.mesh])?;
+    }
     let [w, h] = request_.size;
     if !(1..=cloth_vis::scene::MAX_IMAGE_SIDE).contains(&w)
         || !(1..=cloth_vis::scene::MAX_IMAGE_SIDE).contains(&h)

@@ -249,7 +249,7 @@ pub fn read_cpca(path: &Path) -> Result<(Compressed, usize), Error> {
 /// write errors naming the output.
 pub fn run_compress(request: &CompressRequest) -> Result<CompressSummary, Error> {
     check_cpca_out(&request.out)?;
-    super::refuse_overwriting_input(&request.out, &[&request.input])?;
+    super::check_output_file(&request.out, &[&request.input])?;
     let step = super::spinner(
         request.progress,
         format!("loading {}", request.input.display()),

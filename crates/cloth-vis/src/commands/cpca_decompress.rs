@@ -95,7 +95,11 @@ fn out_kind(out: &Path, force: bool) -> Result<OutKind, Error> {
 /// naming the output. Nothing is written on error.
 pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, Error> {
     let kind = out_kind(&request.out, request.force)?;
-    super::refuse_overwriting_input(&request.out, &[&request.input])?;
+    if matches!(kind, OutKind::ObjFolder(_)) {
+        super::refuse_overwriting_input(&request.out, &[&request.input])?;
+    } else {
+        super::check_output_file(&request.out, &[&request.input])?;
+    }
     let (data, _) = read_cpca(&request.input)?;
     let size = (data.frames(), data.vertices(), data.triangles().len());
     let levers = "write .npy instead of OBJ frames, or decode on the GPU where it is used";

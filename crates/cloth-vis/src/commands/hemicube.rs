@@ -293,7 +293,7 @@ pub fn run_hemicube(
 ) -> Result<HemicubeSummary, Error> {
     let input = &request.input;
     for output in request.out.iter().chain(&request.render) {
-        super::refuse_overwriting_input(output, &[input])?;
+        super::check_output_file(output, &[input])?;
     }
     let out_kind = check_request(request, gpu)?;
     let builder = request.builder.unwrap_or(match gpu {

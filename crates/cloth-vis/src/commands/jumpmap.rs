@@ -239,6 +239,9 @@ pub fn run_jumpmap(
             ));
         }
     };
+    if !matches!(kind, OutKind::ObjFolder(_)) {
+        atomic_out::check_writable(out)?;
+    }
     // The heat-map folder is a folder output too: refused before any work when it holds files.
     let maps_existing = request
         .maps
@@ -262,6 +265,7 @@ pub fn run_jumpmap(
                 ));
             }
             check_strip(request.frames, strip.frames, strip.panel_size, &strip.path)?;
+            super::check_output_file(&strip.path, &inputs)?;
             let Some(gpu) = gpu else {
                 return Err(invalid(
                     &strip.path,

@@ -123,6 +123,23 @@ pub fn refuse_overwriting_input(
     Ok(())
 }
 
+/// [`refuse_overwriting_input`], then whether the file could be written at all
+/// ([`atomic_out::check_writable`]): a folder standing at the path, a read-only folder or a
+/// file system that takes no new files is refused before the work, not after minutes of it.
+/// The check leaves nothing behind.
+///
+/// # Errors
+/// [`cloth_vis::Error::Request`] for an input named as the output; the write's error
+/// (naming the output and the step) for a path that could not be written.
+pub fn check_output_file(
+    output: &std::path::Path,
+    inputs: &[&std::path::Path],
+) -> Result<(), cloth_vis::Error> {
+    refuse_overwriting_input(output, inputs)?;
+    atomic_out::check_writable(output)?;
+    Ok(())
+}
+
 /// Loader options for an animation input: the glTF clip `--clip` names, defaults otherwise.
 pub fn animation_options(
     clip: &meshio::ClipSelector,

@@ -152,7 +152,7 @@ impl ShadowsArgs {
             .validated()
             .map_err(|e| invalid(&self.input, format!("{flag}: {e}")))?;
         for output in std::iter::once(&self.out).chain(&self.render) {
-            super::refuse_overwriting_input(output, &[&self.input])?;
+            super::check_output_file(output, &[&self.input])?;
         }
         if super::visibility::lower_extension(&self.out).as_deref() != Some("npy") {
             return Err(

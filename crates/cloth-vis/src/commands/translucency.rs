@@ -51,7 +51,7 @@ impl ShArgs {
     /// # Errors
     /// Bad flags, an unreadable map, an output that cannot be written — naming the file.
     pub fn run(self) -> anyhow::Result<()> {
-        super::refuse_overwriting_input(&self.out, &[&self.input])?;
+        super::check_output_file(&self.out, &[&self.input])?;
         if super::visibility::lower_extension(&self.out).as_deref() != Some("npy") {
             return Err(
                 invalid(&self.out, "--out must end in .npy (f32 [9, 3])".to_owned()).into(),
@@ -197,7 +197,7 @@ impl TranslucencyArgs {
     /// # Errors
     /// Bad flags before any work; loader, GPU and output errors naming the file.
     pub fn run(self) -> anyhow::Result<()> {
-        super::refuse_overwriting_input(&self.out, &[&self.input])?;
+        super::check_output_file(&self.out, &[&self.input])?;
         let ext = super::visibility::lower_extension(&self.out);
         let still = matches!(ext.as_deref(), Some("png" | "exr"));
         if self.frames.is_some() == still {

@@ -156,7 +156,7 @@ impl ViewArgs {
         }
         if let Some(path) = &self.screenshot {
             check_image_path(path)?;
-            super::refuse_overwriting_input(path, &[&self.input])?;
+            super::check_output_file(path, &[&self.input])?;
         }
         let events = match &self.events {
             Some(path) => cloth_vis::live::read_events(path)?,

@@ -387,7 +387,7 @@ pub fn run_visibility(
 ) -> Result<VisibilitySummary, Error> {
     let input = &request.input;
     for output in request.out.iter().chain(&request.render) {
-        super::refuse_overwriting_input(output, &[input])?;
+        super::check_output_file(output, &[input])?;
     }
     let (out_kind, image_kind) = check_request(request, gpu)?;
     let scene = one_object_scene(request)?;

@@ -9,6 +9,7 @@ mod anim_search;
 mod bake_cmd;
 mod hemicube_cmd;
 mod inspect_cmd;
+mod output_checks;
 mod render_outputs;
 mod shadows_cmd;
 mod translucency_cmd;
