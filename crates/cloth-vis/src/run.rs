@@ -333,15 +333,20 @@ pub fn folder_output(out: &Path, replace: bool) -> Result<atomic_out::ExistingFo
         return Ok(atomic_out::ExistingFolder::Replace);
     }
     let holds_files = std::fs::read_dir(out).is_ok_and(|mut entries| entries.next().is_some());
-    if holds_files || (out.exists() && !out.is_dir()) {
-        return Err(Error::Request {
-            path: out.to_owned(),
-            message: "exists and is not an empty folder; choose a new folder, or pass --force \
-                      to replace it once the new output is complete"
-                .to_owned(),
-        });
-    }
-    Ok(atomic_out::ExistingFolder::Refuse)
+    let what = if holds_files {
+        "is a folder that holds files"
+    } else if out.exists() && !out.is_dir() {
+        "is a file, and this output is a folder"
+    } else {
+        return Ok(atomic_out::ExistingFolder::Refuse);
+    };
+    Err(Error::Request {
+        path: out.to_owned(),
+        message: format!(
+            "{what}; choose a new folder, or pass --force to replace it once the new output \
+             is complete"
+        ),
+    })
 }
 
 /// What every image of a run shares: the camera, the background and where it was drawn.

@@ -142,7 +142,7 @@ fn bad_fin_input_is_refused_naming_the_file_and_nothing_is_written() {
     let out = synth(&dir);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("not an empty folder"),
+        stderr(&out).contains("is a folder that holds files"),
         "{}",
         stderr(&out)
     );

@@ -172,7 +172,7 @@ pub(super) fn dir_bytes(dir: &Path) -> u64 {
 /// Runs `btf synth`: every view slot's primary hits once, then its 81 light images.
 ///
 /// # Errors
-/// An `out` that exists and is not an empty folder (refused before any work); bad generator
+/// An `out` that is a file or a folder holding files (refused before any work); bad generator
 /// parameters ([`Error::Synth`]); write errors. On error nothing is left at `out`.
 pub fn run_synth(request_: &SynthRequest) -> Result<SynthSummary, Error> {
     let out = &request_.out;

@@ -49,7 +49,7 @@ impl FinSynthSummary {
 /// Runs `btf fins synth`.
 ///
 /// # Errors
-/// An `out` that exists and is not an empty folder (refused before any work); bad generator
+/// An `out` that is a file or a folder holding files (refused before any work); bad generator
 /// parameters; write errors. On error nothing is left at `out`.
 pub fn run_synth(
     params: &synth::fins::WoolFinParams,

@@ -66,7 +66,17 @@ fn a_run_folder_is_refused_when_it_holds_files_and_replaced_with_force() {
     assert_eq!(again.status.code(), Some(1));
     let err = String::from_utf8_lossy(&again.stderr);
     assert!(err.contains(text(&out)) && err.contains("--force"), "{err}");
+    assert!(err.contains("is a folder that holds files"), "{err}");
     assert!(out.join("notes.txt").is_file());
+    // A file where the folder would go is called a file.
+    let file = out.join("notes.txt");
+    let refused = cli_env(&["demo", "--quiet", "--out", text(&file)], &ENV);
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        err.contains("notes.txt: is a file, and this output is a folder"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "mine");
 
     // --force: replaced whole once the new run is complete.
     let forced = cli_env(&["demo", "--quiet", "--force", "--out", text(&out)], &ENV);
