@@ -149,7 +149,8 @@ pub fn write_via_path<E>(
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn check_writable(path: &Path) -> Result<(), WriteError> {
-    if std::fs::metadata(path).is_ok_and(|m| m.is_dir()) {
+    // Not followed through a symbolic link: the rename replaces a link, whatever it points to.
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_dir()) {
         return Err(WriteError::new(
             path,
             "replace",

@@ -107,6 +107,17 @@ fn check_writable_refuses_what_a_write_would_and_leaves_nothing() {
         ("replace", std::io::ErrorKind::IsADirectory)
     );
     assert_eq!(entries(&folder), ["inside"]);
+    // A symbolic link to a folder: the write replaces the link, so the check lets it be.
+    #[cfg(unix)]
+    {
+        let link = dir.path().join("link.png");
+        std::os::unix::fs::symlink(&folder, &link).unwrap();
+        check_writable(&link).unwrap();
+        write_bytes(&link, b"png").unwrap();
+        assert!(!link.is_symlink() && std::fs::read(&link).unwrap() == b"png");
+        assert_eq!(entries(&folder), ["inside"]);
+        std::fs::remove_file(&link).unwrap();
+    }
     // A file where a folder should be: the write's own error.
     let err = check_writable(&kept.join("b.npy")).unwrap_err();
     assert_eq!(err.op, "create the folders of");
