@@ -8,6 +8,7 @@
 //! Evaluation streams view slot by view slot with bounded memory.
 
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use crate::compress::{for_each_slot_bounded, resolve_workers};
 use crate::dataset::{BtfDir, ViewSlot};
@@ -123,6 +124,20 @@ impl BtfPca {
     /// [`BtfError::LengthMismatch`] if the folder's size or sampling differs from the PCA's;
     /// [`BtfError::IndexOutOfRange`] for a pair with an index ≥ 81; load errors.
     pub fn stats(&self, dir: &BtfDir, subset: Option<&[(usize, usize)]>) -> Result<ErrorStats> {
+        self.stats_with(dir, subset, None)
+    }
+
+    /// [`BtfPca::stats`], calling `progress(done, total)` after each view slot compared (all
+    /// 6,561 images: 81 slots; a subset: the slots it touches).
+    ///
+    /// # Errors
+    /// As [`BtfPca::stats`].
+    pub fn stats_with(
+        &self,
+        dir: &BtfDir,
+        subset: Option<&[(usize, usize)]>,
+        progress: Option<&(dyn Fn(usize, usize) + Sync)>,
+    ) -> Result<ErrorStats> {
         self.check_size("BtfPca::stats dir", dir.width(), dir.height())?;
         if dir.sampling() != self.sampling {
             return Err(BtfError::InvalidParameter {
@@ -133,6 +148,13 @@ impl BtfPca {
             });
         }
         let workers = resolve_workers(0);
+        let done = AtomicUsize::new(0);
+        let tick = |total: usize| {
+            let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if let Some(p) = progress {
+                p(d, total);
+            }
+        };
         let acc = match subset {
             None => for_each_slot_bounded(workers, DIRECTIONS, |j| {
                 let slot = dir.load_view(j)?;
@@ -140,6 +162,7 @@ impl BtfPca {
                 for i in 0..LIGHTS {
                     acc.add_image(slot.image(i), &self.image(j, i));
                 }
+                tick(DIRECTIONS);
                 Ok(acc)
             })?,
             Some(pairs) => {
@@ -164,6 +187,7 @@ impl BtfPca {
                         let original = dir.load_image(*j, i)?;
                         acc.add_image(&original, &self.image(*j, i));
                     }
+                    tick(views.len());
                     Ok(acc)
                 })?
             }

@@ -98,6 +98,22 @@ fn woven_btf_folder_round_trip_and_stats() {
         .stats(&btf, Some(&[(0, 0), (40, 12), (80, 80)]))
         .unwrap();
     assert_eq!(some.images, 3);
+    // The progress callback: once per slot compared, ending at (total, total), the same stats.
+    let calls = std::sync::Mutex::new(Vec::new());
+    let record = |done: usize, total: usize| calls.lock().unwrap().push((done, total));
+    assert_eq!(pca.stats_with(&btf, None, Some(&record)).unwrap(), all);
+    let seen = std::mem::take(&mut *calls.lock().unwrap());
+    assert_eq!(seen.len(), DIRECTIONS);
+    assert_eq!(seen.iter().map(|c| c.0).max(), Some(DIRECTIONS));
+    assert!(
+        seen.iter()
+            .all(|&(d, t)| t == DIRECTIONS && (1..=t).contains(&d))
+    );
+    let subset = [(0, 0), (40, 12), (40, 13), (80, 80)];
+    pca.stats_with(&btf, Some(&subset), Some(&record)).unwrap();
+    let mut seen = calls.into_inner().unwrap();
+    seen.sort_unstable();
+    assert_eq!(seen, [(1, 3), (2, 3), (3, 3)], "three view slots touched");
     // All components: only the 8-bit storage of the eigen-normtextures is lost.
     assert!(all.rms_srgb8 < 1.5, "{all:?}");
     assert!(some.rms_srgb8.is_finite() && some.max_abs_srgb8 <= all.max_abs_srgb8);

@@ -143,11 +143,8 @@ impl BakeArgs {
     pub fn run(self) -> anyhow::Result<()> {
         let summary = bake(&self)?;
         let mut line = format!(
-            "bake: a_i of {} vertices over {} directions in {:.1} ms -> {}",
-            summary.vertices,
-            summary.directions,
-            summary.millis,
-            self.out.display()
+            "bake: a_i of {} vertices over {} directions in {:.1} ms",
+            summary.vertices, summary.directions, summary.millis,
         );
         if let Some(r) = &summary.gltf {
             line.push_str(&format!(
@@ -169,7 +166,7 @@ impl BakeArgs {
                 },
             ));
         }
-        super::print_line(&line)
+        super::print_summary(&line, [self.out.as_path()])
     }
 }
 

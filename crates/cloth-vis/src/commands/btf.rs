@@ -285,8 +285,12 @@ pub fn run_stats(dir: &Path, file: &Path, progress: bool) -> Result<StatsSummary
             ),
         ));
     }
-    let bar = bar(progress, 1, "comparing");
-    let error = pca.stats(&folder, None)?;
+    let bar = bar(progress, btf::DIRECTIONS as u64, "view slots compared");
+    let error = pca.stats_with(
+        &folder,
+        None,
+        Some(&|done, _| bar.set_position(done as u64)),
+    )?;
     bar.finish_and_clear();
     let kept = pca.slots().iter().map(|s| s.components());
     Ok(StatsSummary {
@@ -323,31 +327,35 @@ impl BtfCommand {
     /// Run the subcommand; print its summary line.
     pub fn run(self) -> anyhow::Result<()> {
         let line = match self {
-            Self::Synth(a) => run_synth(&SynthRequest {
-                params: synth::WovenBtfParams {
-                    res: a.res,
-                    supersample: a.supersample,
-                    ..Default::default()
-                },
-                sampling: a.sampling,
-                out: a.out,
-                force: a.force,
-                progress: !a.quiet,
-            })?
-            .line(),
-            Self::Compress(a) => run_compress(&CompressRequest {
-                dir: a.dir,
-                params: BtfPcaParams {
-                    components: a.components,
-                    storage: a.storage,
-                    mean_storage: a.mean_storage,
-                    ..Default::default()
-                },
-                out: a.out,
-                progress: !a.quiet,
-            })?
-            .line(),
-            Self::Stats(a) => run_stats(&a.dir, &a.file, false)?.line(),
+            Self::Synth(a) => {
+                let request = SynthRequest {
+                    params: synth::WovenBtfParams {
+                        res: a.res,
+                        supersample: a.supersample,
+                        ..Default::default()
+                    },
+                    sampling: a.sampling,
+                    out: a.out,
+                    force: a.force,
+                    progress: !a.quiet,
+                };
+                super::with_wrote(run_synth(&request)?.line(), [request.out.as_path()])
+            }
+            Self::Compress(a) => {
+                let request = CompressRequest {
+                    dir: a.dir,
+                    params: BtfPcaParams {
+                        components: a.components,
+                        storage: a.storage,
+                        mean_storage: a.mean_storage,
+                        ..Default::default()
+                    },
+                    out: a.out,
+                    progress: !a.quiet,
+                };
+                super::with_wrote(run_compress(&request)?.line(), [request.out.as_path()])
+            }
+            Self::Stats(a) => run_stats(&a.dir, &a.file, !a.quiet)?.line(),
             Self::Render(a) => a.run()?,
             Self::Fins { command } => command.run()?,
         };
@@ -407,6 +415,9 @@ pub struct StatsArgs {
     dir: PathBuf,
     /// The .btfpca file.
     file: PathBuf,
+    /// Hide the progress bar.
+    #[arg(long)]
+    quiet: bool,
 }
 
 fn parse_sampling(text: &str) -> Result<Sampling, String> {

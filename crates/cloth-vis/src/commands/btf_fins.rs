@@ -193,7 +193,8 @@ impl FinsCommand {
                     seed: a.seed,
                     ..defaults
                 };
-                run_synth(&params, &a.out, a.force, !a.quiet)?.line()
+                let line = run_synth(&params, &a.out, a.force, !a.quiet)?.line();
+                super::with_wrote(line, [a.out.as_path()])
             }
             Self::Compress(a) => {
                 let params = BtfPcaParams {
@@ -202,7 +203,8 @@ impl FinsCommand {
                     mean_storage: a.mean_storage,
                     ..Default::default()
                 };
-                run_compress(&a.dir, &params, &a.out)?.line()
+                let line = run_compress(&a.dir, &params, &a.out)?.line();
+                super::with_wrote(line, [a.out.as_path()])
             }
         })
     }

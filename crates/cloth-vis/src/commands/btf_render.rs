@@ -689,6 +689,7 @@ impl RenderArgs {
             out: self.out,
             progress: !self.quiet,
         };
-        Ok(run_render(&request, gpu.as_ref())?.line())
+        let line = run_render(&request, gpu.as_ref())?.line();
+        Ok(super::with_wrote(line, [request.out.as_path()]))
     }
 }

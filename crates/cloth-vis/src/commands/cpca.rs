@@ -577,7 +577,8 @@ impl CompressArgs {
             out: self.out,
             progress: !self.quiet,
         };
-        super::print_line(&run_compress(&request)?.line())
+        let line = run_compress(&request)?.line();
+        super::print_summary(&line, [request.out.as_path()])
     }
 }
 
@@ -629,6 +630,8 @@ impl StatsArgs {
             frontier: self.frontier,
             progress: !self.quiet,
         };
-        super::print_line(&run_stats_with_pictures(&request, gpu.as_ref())?.line())
+        let line = run_stats_with_pictures(&request, gpu.as_ref())?.line();
+        let outputs = [&request.clusters_png, &request.error_plot];
+        super::print_summary(&line, outputs.into_iter().flatten().map(PathBuf::as_path))
     }
 }

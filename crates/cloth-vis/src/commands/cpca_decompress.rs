@@ -247,6 +247,7 @@ impl DecompressArgs {
             force: self.force,
             progress: !self.quiet,
         };
-        super::print_line(&run_decompress(&request)?.line())
+        let line = run_decompress(&request)?.line();
+        super::print_summary(&line, [request.out.as_path()])
     }
 }

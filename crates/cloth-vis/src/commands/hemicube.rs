@@ -633,6 +633,8 @@ impl HemicubeArgs {
             (None, Some(Builder::Cpu)) => None,
             (None, None) => super::optional_gpu(),
         };
-        super::print_line(&run_hemicube(&request, gpu.as_ref())?.line())
+        let line = run_hemicube(&request, gpu.as_ref())?.line();
+        let outputs = [&request.out, &request.render];
+        super::print_summary(&line, outputs.into_iter().flatten().map(PathBuf::as_path))
     }
 }

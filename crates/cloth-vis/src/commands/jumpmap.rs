@@ -84,6 +84,8 @@ pub struct JumpMapRequest {
     /// A rendered strip of frames of the generated sequence (`None`: none written; needs a
     /// GPU adapter, lavapipe is fine).
     pub strip: Option<StripRequest>,
+    /// Show a spinner naming each step (stderr, terminals only).
+    pub progress: bool,
 }
 
 /// What was generated.
@@ -277,6 +279,10 @@ pub fn run_jumpmap(
             Some((strip, gpu))
         }
     };
+    let step = super::spinner(
+        request.progress,
+        format!("loading {}", request.input.display()),
+    );
     let (clip, _) = meshio::load_animation(
         &request.input,
         &super::animation_options(&request.clip, request.topology.as_deref()),
@@ -356,9 +362,14 @@ pub fn run_jumpmap(
             ));
         }
     }
+    step.set_message(format!(
+        "analysing {} frames (PCA, frame distances, transitions)",
+        clip.frames.len() + cells.iter().map(|c| c.frames.len()).sum::<usize>()
+    ));
     let map = JumpMap::analyze_cells(&clips, &request.params)
         .map_err(|e| anim_error(&request.input, e))?;
     let mut loop_info = None;
+    step.set_message(format!("generating {} frames", request.frames));
     let generated = match control.loop_length {
         Some(n) => {
             let cell = map.cell_of(request.playback.start_frame.min(map.n_frames() - 1));
@@ -418,6 +429,7 @@ pub fn run_jumpmap(
         frames.push(mesh);
     }
     if let Some((strip, gpu)) = strip_gpu {
+        step.set_message(format!("rendering {}", strip.path.display()));
         let image = render_strip(
             &gpu.device,
             &gpu.queue,
@@ -432,14 +444,10 @@ pub fn run_jumpmap(
         )?;
         write_png(&strip.path, &image)?;
     }
+    step.set_message(format!("writing {}", out.display()));
     match kind {
-        OutKind::Npy => {
-            let data: Vec<f32> = frames
-                .iter()
-                .flat_map(|f| f.iter().flat_map(|v| v.to_array()))
-                .collect();
-            meshio::write_npy_f32(out, &[frames.len(), vertices, 3], &data)?;
-        }
+        // Streamed frame by frame: no second copy of the run in memory.
+        OutKind::Npy => meshio::write_npy_frames(out, frames.len(), vertices, &frames)?,
         OutKind::Glb => {
             if clip.triangles.is_empty() {
                 return Err(invalid(
@@ -480,6 +488,7 @@ pub fn run_jumpmap(
     if let (Some(dir), Some(existing)) = (&request.maps, maps_existing) {
         write_maps(dir, existing, &map)?;
     }
+    step.finish_and_clear();
     Ok(JumpMapSummary {
         clip_frames: map.n_frames(),
         vertices,
@@ -731,6 +740,9 @@ pub struct JumpmapArgs {
         default_value = "256x256"
     )]
     strip_size: [u32; 2],
+    /// Hide the progress spinner.
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// `--memory-gb`: a finite number of gigabytes > 0.
@@ -783,6 +795,7 @@ impl JumpmapArgs {
                 frames: self.strip_frames,
                 panel_size: self.strip_size,
             }),
+            progress: !self.quiet,
         }
     }
 
@@ -794,6 +807,9 @@ impl JumpmapArgs {
             None => None,
         };
         let summary = run_jumpmap(&request, gpu.as_ref())?;
-        super::print_line(&summary.line())
+        let outputs = std::iter::once(&request.out)
+            .chain(&request.maps)
+            .chain(request.strip.as_ref().map(|s| &s.path));
+        super::print_summary(&summary.line(), outputs.map(PathBuf::as_path))
     }
 }

@@ -158,6 +158,36 @@ pub fn print_line(line: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Print a command's summary line, then `wrote A, B` naming every file or folder it wrote
+/// (the last line of every command that writes, so that a script or a reader sees where the
+/// results went without reading the flags again); the summary alone when it wrote nothing.
+pub fn print_summary<'a>(
+    line: &str,
+    outputs: impl IntoIterator<Item = &'a std::path::Path>,
+) -> anyhow::Result<()> {
+    print_line(&with_wrote(line.to_owned(), outputs))
+}
+
+/// `line`, then (when there are outputs) [`wrote_line`] on a line of its own.
+pub fn with_wrote<'a>(
+    line: String,
+    outputs: impl IntoIterator<Item = &'a std::path::Path>,
+) -> String {
+    match wrote_line(outputs) {
+        Some(wrote) => format!("{line}\n{wrote}"),
+        None => line,
+    }
+}
+
+/// `wrote A, B`: the outputs' paths as given; `None` for no output.
+pub fn wrote_line<'a>(outputs: impl IntoIterator<Item = &'a std::path::Path>) -> Option<String> {
+    let names: Vec<String> = outputs
+        .into_iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    (!names.is_empty()).then(|| format!("wrote {}", names.join(", ")))
+}
+
 /// A spinner on stderr for one long step whose length is unknown (a clustered PCA fit, one
 /// loading an animation): `message` and the elapsed time, ticking on its own thread.
 /// indicatif draws nothing when stderr is not a terminal, so pipelines and tests stay clean;

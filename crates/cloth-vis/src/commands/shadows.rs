@@ -91,6 +91,9 @@ pub struct ShadowsArgs {
     /// Rendered image size.
     #[arg(long, value_name = "WxH", value_parser = super::parse::size, default_value = DEFAULT_RENDER_SIZE)]
     render_size: [u32; 2],
+    /// Hide the progress spinner (loading, a --lod search, casting, drawing).
+    #[arg(long)]
+    quiet: bool,
 }
 
 /// Why no mesh can shadow the ground y = `ground` (in the stood-up frame), when that is so: the
@@ -189,6 +192,7 @@ impl ShadowsArgs {
                 self.exposure,
             )?;
         }
+        let step = super::spinner(!self.quiet, format!("loading {}", self.input.display()));
         let scene = display_scene(
             &self.input,
             self.topology.as_deref(),
@@ -238,6 +242,11 @@ impl ShadowsArgs {
         .map_err(|e| invalid(&self.input, e.to_string()))?;
         let (caster, lod_note) = match lod {
             Some(target) => {
+                step.set_message(format!(
+                    "simplifying the caster's {} triangles (--lod {})",
+                    mesh.triangles.len(),
+                    self.lod.as_deref().unwrap_or_default()
+                ));
                 let level = shadows::caster_lod(
                     &mesh.positions,
                     &mesh.triangles,
@@ -268,6 +277,7 @@ impl ShadowsArgs {
                 }
             }
         };
+        step.set_message(format!("casting {} triangles", caster.len()));
         let start = Instant::now();
         let (mask, method) = match (&gpu, self.cpu) {
             (Some(gpu), false) => {
@@ -292,8 +302,10 @@ impl ShadowsArgs {
         meshio::write_npy_f32(&self.out, &[grid.n, grid.n], &mask)?;
         let unshadowable = nothing_casts(&mesh.positions, &light, grid.y);
         if let (Some(path), Some(gpu)) = (&self.render, &gpu) {
+            step.set_message(format!("drawing {}", path.display()));
             self.draw(path, gpu, &scene, mesh, (&grid, &mask), light, sides)?;
         }
+        step.finish_and_clear();
         let shadowed = mask.iter().filter(|&&v| v > 0.0).count() as f64 / mask.len() as f64;
         super::print_line(&format!(
             "shadows: {} triangles (caster) in {millis:.1} ms{lod_note}, {method}, {}-sided, \
@@ -309,6 +321,10 @@ impl ShadowsArgs {
                 "note: {why}, so nothing can shadow the ground (--ground is a height along the \
                  up axis, --light-dir points towards the light)"
             ))?;
+        }
+        let outputs = std::iter::once(&self.out).chain(&self.render);
+        if let Some(wrote) = super::wrote_line(outputs.map(PathBuf::as_path)) {
+            super::print_line(&wrote)?;
         }
         Ok(())
     }

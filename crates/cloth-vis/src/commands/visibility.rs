@@ -749,7 +749,9 @@ impl VisibilityArgs {
             progress: !self.quiet,
             force: self.force,
         };
-        super::print_line(&run_visibility(&request, gpu.as_ref())?.line())
+        let line = run_visibility(&request, gpu.as_ref())?.line();
+        let outputs = [&request.out, &request.render];
+        super::print_summary(&line, outputs.into_iter().flatten().map(PathBuf::as_path))
     }
 }
 

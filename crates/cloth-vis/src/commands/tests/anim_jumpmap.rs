@@ -71,6 +71,7 @@ fn request(input: PathBuf, out: PathBuf) -> JumpMapRequest {
         memory_limit: crate::commands::jumpmap::MAX_GENERATED_BYTES,
         maps: None,
         strip: None,
+        progress: false,
     }
 }
 

@@ -2,6 +2,8 @@
 //! standing at the output is named at once, before the (here missing) input is even opened,
 //! and nothing is left behind.
 
+use std::path::Path;
+
 use super::common::{cli, text};
 
 #[test]
@@ -92,4 +94,93 @@ fn an_output_in_a_folder_that_takes_no_files_is_refused_first() {
         "{stderr}"
     );
     assert!(!stderr.contains("missing.ply"), "{stderr}");
+}
+
+/// Every command that writes ends with `wrote A, B`: each output it wrote, as given, in the
+/// order of its flags (the main output first), and each of them there.
+#[test]
+fn a_command_that_writes_names_its_outputs_last() {
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name);
+    // A square over a larger one: something to occlude and to shadow, in under a second.
+    let input = at("squares.obj");
+    std::fs::write(
+        &input,
+        "v -0.25 1 -0.5\nv 0.75 1 -0.5\nv 0.75 1 0.5\nv -0.25 1 0.5\n\
+         v -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\n\
+         f 1 2 3\nf 1 3 4\nf 5 7 6\nf 5 8 7\n",
+    )
+    .unwrap();
+    let input = text(&input);
+    let (ao, hc, mask, baked) = (at("ao.npy"), at("hc.npy"), at("mask.npy"), at("baked.obj"));
+    let (fins, finpca) = (at("fins"), at("fins.finpca"));
+    let cases: Vec<(Vec<&str>, Vec<&Path>)> = vec![
+        (
+            vec!["visibility", input, "--backend", "cpu", "-o", text(&ao)],
+            vec![&ao],
+        ),
+        (
+            vec![
+                "hemicube",
+                input,
+                "--builder",
+                "cpu",
+                "--res",
+                "8",
+                "-o",
+                text(&hc),
+            ],
+            vec![&hc],
+        ),
+        (
+            vec![
+                "shadows",
+                input,
+                "--ground",
+                "0",
+                "--light-pos",
+                "0,3,0",
+                "--cpu",
+                "--grid",
+                "16",
+                "-o",
+                text(&mask),
+            ],
+            vec![&mask],
+        ),
+        (vec!["bake", input, "-o", text(&baked)], vec![&baked]),
+        (
+            vec![
+                "btf",
+                "fins",
+                "synth",
+                "--size",
+                "8x8",
+                "--quiet",
+                "-o",
+                text(&fins),
+            ],
+            vec![&fins],
+        ),
+        (
+            vec!["btf", "fins", "compress", text(&fins), "-o", text(&finpca)],
+            vec![&finpca],
+        ),
+    ];
+    for (args, outputs) in &cases {
+        let run = cli(args);
+        let stdout = String::from_utf8_lossy(&run.stdout);
+        assert!(
+            run.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let names: Vec<String> = outputs.iter().map(|p| p.display().to_string()).collect();
+        assert_eq!(
+            stdout.lines().last(),
+            Some(format!("wrote {}", names.join(", ")).as_str()),
+            "{args:?}: {stdout}"
+        );
+        assert!(outputs.iter().all(|p| p.exists()), "{args:?}");
+    }
 }
