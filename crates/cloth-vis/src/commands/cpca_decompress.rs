@@ -187,7 +187,7 @@ pub fn run_decompress(request: &DecompressRequest) -> Result<DecompressSummary, 
             )?;
             eprintln!("{line}");
         }
-        OutKind::ObjFolder(existing) => super::jumpmap::write_obj_frames(
+        OutKind::ObjFolder(existing) => super::obj_frames::write_obj_frames(
             &request.out,
             existing,
             (0..frames).map(|f| {

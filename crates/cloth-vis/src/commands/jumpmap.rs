@@ -4,7 +4,6 @@
 //! as PNG heat maps (the thesis's Fig. 3.3) and a rendered strip of frames of the new
 //! sequence ([`figures::strip`]).
 
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use anim_pca::{Blend, Clip, JumpMap, JumpMapParams, LoopTable, PlaybackParams, Player};
@@ -368,49 +367,8 @@ pub fn run_jumpmap(
     ));
     let map = JumpMap::analyze_cells(&clips, &request.params)
         .map_err(|e| anim_error(&request.input, e))?;
-    let mut loop_info = None;
     step.set_message(format!("generating {} frames", request.frames));
-    let generated = match control.loop_length {
-        Some(n) => {
-            let cell = map.cell_of(request.playback.start_frame.min(map.n_frames() - 1));
-            // A quarter beyond n, for the nearest lengths to offer when n has no loop.
-            let reach = (n + n / 4 + 2).min(anim_pca::jumpmap::loops::MAX_LOOP_LENGTH);
-            let table = LoopTable::build(&map, cell, reach, request.playback.blend)
-                .map_err(|e| anim_error(&request.input, e))?;
-            let Some(found) = table.get(n) else {
-                return Err(invalid(&request.input, no_loop_message(&table, n)));
-            };
-            loop_info = Some(LoopInfo {
-                length: n,
-                jumps: found.transitions.len(),
-                distinct_frames: found.distinct_frames(),
-                shortest_run: found.shortest_run(),
-                cost: found.cost,
-                core_frames: table.core_frames(),
-            });
-            found.play(request.frames)
-        }
-        None => {
-            let mut player =
-                Player::new(&map, &request.playback).map_err(|e| anim_error(&request.input, e))?;
-            let mut schedule = control.cell_at.clone();
-            schedule.sort_by_key(|&(at, _)| at);
-            let mut generated = anim_pca::Generated::default();
-            for (at, cell) in schedule {
-                let upto = at.min(request.frames);
-                let part = player.generate(upto.saturating_sub(generated.frames.len()));
-                generated.frames.extend(part.frames);
-                generated.transitions.extend(part.transitions);
-                player
-                    .set_target_cell(cell)
-                    .map_err(|e| anim_error(&request.input, e))?;
-            }
-            let rest = player.generate(request.frames - generated.frames.len());
-            generated.frames.extend(rest.frames);
-            generated.transitions.extend(rest.transitions);
-            generated
-        }
-    };
+    let (generated, loop_info) = generate(&map, request)?;
     let stats = anim_pca::jumpmap::metrics::sequence_stats(&map, &generated);
     let offsets = map.root_offsets(&generated.frames);
 
@@ -477,7 +435,7 @@ pub fn run_jumpmap(
             )?;
             eprintln!("{line}");
         }
-        OutKind::ObjFolder(existing) => write_obj_frames(
+        OutKind::ObjFolder(existing) => super::obj_frames::write_obj_frames(
             out,
             existing,
             frames.iter().map(Ok),
@@ -486,7 +444,7 @@ pub fn run_jumpmap(
         )?,
     }
     if let (Some(dir), Some(existing)) = (&request.maps, maps_existing) {
-        write_maps(dir, existing, &map)?;
+        super::jumpmap_maps::write_maps(dir, existing, &map)?;
     }
     step.finish_and_clear();
     Ok(JumpMapSummary {
@@ -498,122 +456,54 @@ pub fn run_jumpmap(
     })
 }
 
-/// Numbered OBJ frames `frame_00000.obj` … in the folder `dir`, with the comment line
-/// `# {what}, frame N`: built in a temporary folder beside it and renamed into place when every
-/// frame is written (`atomic_out::write_dir`), so an interrupted run leaves no shorter clip
-/// that looks complete; `existing` says what happens to a folder that holds files.
-/// Frames come from an iterator (a decoder streams them: one frame in memory at a time).
-pub(crate) fn write_obj_frames<P: AsRef<[Vec3]>>(
-    dir: &Path,
-    existing: atomic_out::ExistingFolder,
-    frames: impl IntoIterator<Item = Result<P, Error>>,
-    triangles: &[[u32; 3]],
-    what: &str,
-) -> Result<(), Error> {
-    atomic_out::write_dir(dir, existing, |tmp| {
-        for (f, positions) in frames.into_iter().enumerate() {
-            let name = format!("frame_{f:05}.obj");
-            write_obj_frame(&tmp.join(&name), f, positions?.as_ref(), triangles, what).map_err(
-                |e| Error::Io {
-                    path: dir.join(&name),
-                    reason: e.to_string(),
-                },
-            )?;
-        }
-        Ok(())
-    })?;
-    Ok(())
-}
-
-fn write_obj_frame(
-    path: &Path,
-    f: usize,
-    positions: &[Vec3],
-    triangles: &[[u32; 3]],
-    what: &str,
-) -> std::io::Result<()> {
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(w, "# {what}, frame {f}")?;
-    for p in positions {
-        writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
-    }
-    for t in triangles {
-        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
-    }
-    w.into_inner().map_err(|e| e.into_error())?.sync_all()
-}
-
-/// The five matrices of the analysis as heat maps, one pixel per entry (scaled up to at least
-/// 256 pixels a side): distances linearly from 0 to their maximum, probabilities on a log
-/// scale over six decades below the matrix's maximum (as the thesis's Fig. 3.3 shows them,
-/// black = 0).
-fn write_maps(
-    dir: &Path,
-    existing: atomic_out::ExistingFolder,
+/// The new sequence `request` asks of `map`: the cheapest loop of `--loop` frames, or random
+/// play steered by `--cell-at`; with the loop's figures.
+fn generate(
     map: &JumpMap,
-) -> Result<(), Error> {
-    atomic_out::write_dir(dir, existing, |tmp| write_map_files(tmp, map)).map_err(Error::from)
-}
-
-fn write_map_files(dir: &Path, map: &JumpMap) -> Result<(), Error> {
-    let maps: [(&str, &anim_pca::SquareMatrix, bool); 5] = [
-        ("D.png", map.distances(), false),
-        ("D_velocity.png", map.velocity_distances(), false),
-        ("P.png", map.position_probabilities(), true),
-        ("P_velocity.png", map.velocity_probabilities(), true),
-        ("P_hat.png", map.jump_map(), true),
-    ];
-    for (name, matrix, log) in maps {
-        write_heat_map(&dir.join(name), matrix, log)?;
-    }
-    Ok(())
-}
-
-/// Decades below the maximum shown by a log-scale heat map.
-const LOG_DECADES: f64 = 6.0;
-
-/// Value in [0, 1] → a dark-blue … yellow ramp (a simple perceptual map, black at 0).
-fn ramp(t: f64) -> [u8; 3] {
-    let t = t.clamp(0.0, 1.0);
-    let stops = [
-        [0.0, 0.0, 0.0],
-        [0.15, 0.10, 0.45],
-        [0.75, 0.20, 0.45],
-        [0.98, 0.60, 0.15],
-        [1.0, 1.0, 0.6],
-    ];
-    let x = t * (stops.len() - 1) as f64;
-    let i = (x.floor() as usize).min(stops.len() - 2);
-    let f = x - i as f64;
-    let c = |k: usize| stops[i][k] * (1.0 - f) + stops[i + 1][k] * f;
-    [0, 1, 2].map(|k| (c(k) * 255.0 + 0.5) as u8)
-}
-
-fn write_heat_map(path: &Path, matrix: &anim_pca::SquareMatrix, log: bool) -> Result<(), Error> {
-    let n = matrix.n();
-    let max = matrix.max();
-    let scale = (256usize.div_ceil(n.max(1))).max(1);
-    let side = (n * scale) as u32;
-    let value = |i: usize, j: usize| {
-        let v = matrix.get(i, j);
-        if !(v.is_finite() && max.is_finite() && max > 0.0) {
-            return 0.0;
+    request: &JumpMapRequest,
+) -> Result<(anim_pca::Generated, Option<LoopInfo>), Error> {
+    let control = &request.control;
+    Ok(match control.loop_length {
+        Some(n) => {
+            let cell = map.cell_of(request.playback.start_frame.min(map.n_frames() - 1));
+            // A quarter beyond n, for the nearest lengths to offer when n has no loop.
+            let reach = (n + n / 4 + 2).min(anim_pca::jumpmap::loops::MAX_LOOP_LENGTH);
+            let table = LoopTable::build(map, cell, reach, request.playback.blend)
+                .map_err(|e| anim_error(&request.input, e))?;
+            let Some(found) = table.get(n) else {
+                return Err(invalid(&request.input, no_loop_message(&table, n)));
+            };
+            let info = LoopInfo {
+                length: n,
+                jumps: found.transitions.len(),
+                distinct_frames: found.distinct_frames(),
+                shortest_run: found.shortest_run(),
+                cost: found.cost,
+                core_frames: table.core_frames(),
+            };
+            (found.play(request.frames), Some(info))
         }
-        if log {
-            if v <= 0.0 {
-                0.0
-            } else {
-                1.0 + (v / max).log10() / LOG_DECADES
+        None => {
+            let mut player =
+                Player::new(map, &request.playback).map_err(|e| anim_error(&request.input, e))?;
+            let mut schedule = control.cell_at.clone();
+            schedule.sort_by_key(|&(at, _)| at);
+            let mut generated = anim_pca::Generated::default();
+            for (at, cell) in schedule {
+                let upto = at.min(request.frames);
+                let part = player.generate(upto.saturating_sub(generated.frames.len()));
+                generated.frames.extend(part.frames);
+                generated.transitions.extend(part.transitions);
+                player
+                    .set_target_cell(cell)
+                    .map_err(|e| anim_error(&request.input, e))?;
             }
-        } else {
-            v / max
+            let rest = player.generate(request.frames - generated.frames.len());
+            generated.frames.extend(rest.frames);
+            generated.transitions.extend(rest.transitions);
+            (generated, None)
         }
-    };
-    let image = image::RgbaImage::from_fn(side, side, |x, y| {
-        let [r, g, b] = ramp(value(y as usize / scale, x as usize / scale));
-        image::Rgba([r, g, b, 255])
-    });
-    Ok(write_png(path, &image)?)
+    })
 }
 
 /// Parses `--cell-at FRAME:CELL`.

@@ -17,6 +17,8 @@ pub mod env_args;
 pub mod hemicube;
 pub mod inspect;
 pub mod jumpmap;
+mod jumpmap_maps;
+mod obj_frames;
 mod output_size;
 pub mod parse;
 pub mod render;
