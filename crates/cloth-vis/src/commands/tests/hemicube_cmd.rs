@@ -54,7 +54,7 @@ fn open_fraction_matches_the_library_with_nan_for_unused_vertices() {
     let dir = tempfile::tempdir().unwrap();
     let input = floor_and_roof(dir.path());
     let out = dir.path().join("a.npy");
-    let line = run_ok(&[
+    let stdout = run_ok(&[
         "hemicube",
         text(&input),
         "--res",
@@ -64,14 +64,16 @@ fn open_fraction_matches_the_library_with_nan_for_unused_vertices() {
         "--out",
         text(&out),
     ]);
+    let lines: Vec<&str> = stdout.lines().collect();
+    let [line, wrote] = lines[..] else {
+        panic!("a summary and a `wrote` line: {stdout}");
+    };
     assert!(
-        line.starts_with("hemicube: HC 16x16 x 30 vertices in "),
+        line.starts_with("hemicube: HC 16x16 x 30 vertices in ")
+            && line.ends_with(" ms (cpu), 112 bytes per vertex"),
         "{line}"
     );
-    assert!(
-        line.trim_end().ends_with(" ms (cpu), 112 bytes per vertex"),
-        "{line}"
-    );
+    assert_eq!(wrote, format!("wrote {}", out.display()));
     let array = meshio::read_npy_f32(&out).unwrap();
     assert_eq!(array.shape, vec![30]);
     let (mesh, _) = meshio::load_mesh(&input, &meshio::LoadOptions::default()).unwrap();
