@@ -1,7 +1,9 @@
 //! Named adversarial inputs: each gives a clear error (never a panic) or a documented result.
 
-#[path = "../common/mod.rs"]
 mod common;
+// The glTF cases, in a folder beside this file (a file directly under tests/ would be a test
+// target of its own).
+#[path = "hard_cases/gltf.rs"]
 mod gltf;
 
 use std::path::{Path, PathBuf};
