@@ -106,8 +106,7 @@ impl ShArgs {
             let b = sh.irradiance(r);
             text.push_str(&format!("  {name}: {:.5} {:.5} {:.5}\n", b[0], b[1], b[2]));
         }
-        text.push_str(&format!("wrote {}", self.out.display()));
-        super::print_line(&text)
+        super::print_summary(text.trim_end(), [self.out.as_path()])
     }
 }
 
@@ -242,8 +241,7 @@ impl TranslucencyArgs {
                 text.push_str(&format!("{}: {:.1} ms\n", s.stage, s.millis));
             }
         }
-        text.push_str(&format!("wrote {}", self.out.display()));
-        super::print_line(&text)
+        super::print_summary(text.trim_end(), [self.out.as_path()])
     }
 
     /// The one-object scene the flags describe.
