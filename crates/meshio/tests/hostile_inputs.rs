@@ -235,16 +235,9 @@ fn point_cache_headers_claiming_exabytes_stay_within_a_kilobyte() {
 
 /// A one-triangle glTF whose buffer is the file `uri`.
 fn gltf_with_uri(dir: &Path, uri: &str) -> PathBuf {
-    let doc = json!({
-        "asset": {"version": "2.0"},
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-        "buffers": [{"byteLength": 36, "uri": uri}],
-        "bufferViews": [{"buffer": 0, "byteLength": 36}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
-                       "min": [0, 0, 0], "max": [1, 1, 0]}],
-    });
+    let accessor = json!({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                          "min": [0, 0, 0], "max": [1, 1, 0]});
+    let doc = common::one_mesh_gltf(accessor, uri);
     write(dir, "leak.gltf", serde_json::to_vec(&doc).unwrap())
 }
 

@@ -49,6 +49,20 @@ pub fn directed_edges(triangles: &[[u32; 3]]) -> HashMap<(u32, u32), usize> {
     edges
 }
 
+/// A glTF of one mesh whose POSITION is `accessor`, read from a 36-byte buffer at `uri`
+/// through one buffer view: the skeleton the crafted (and hostile) glTF cases vary.
+pub fn one_mesh_gltf(accessor: serde_json::Value, uri: &str) -> serde_json::Value {
+    serde_json::json!({
+        "asset": {"version": "2.0"},
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "buffers": [{"byteLength": 36, "uri": uri}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [accessor],
+    })
+}
+
 /// Standard base64 (for data URIs in crafted glTF files).
 pub fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

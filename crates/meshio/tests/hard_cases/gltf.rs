@@ -17,17 +17,7 @@ fn gltf(dir: &Path, doc: serde_json::Value) -> PathBuf {
 fn corrupt_gltf_files_are_errors_not_panics() {
     let dir = tempfile::tempdir().unwrap();
     let positions = common::base64(&[0u8; 36]);
-    let base = |accessor: serde_json::Value, uri: String| {
-        serde_json::json!({
-            "asset": {"version": "2.0"},
-            "scenes": [{"nodes": [0]}],
-            "nodes": [{"mesh": 0}],
-            "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
-            "buffers": [{"byteLength": 36, "uri": uri}],
-            "bufferViews": [{"buffer": 0, "byteLength": 36}],
-            "accessors": [accessor],
-        })
-    };
+    let base = |accessor: serde_json::Value, uri: String| common::one_mesh_gltf(accessor, &uri);
     let good = serde_json::json!({"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [0, 0, 0]});
     let data_uri = format!("data:application/octet-stream;base64,{positions}");
     // Sanity: the good file loads (one degenerate triangle at the origin).
