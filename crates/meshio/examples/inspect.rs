@@ -60,6 +60,10 @@ fn main() {
             );
             println!("duplicate positions: {}", report.duplicate_positions);
             println!(
+                "repeated triangles: {}, back-to-back pairs: {}",
+                report.repeated_triangles.repeated, report.repeated_triangles.back_to_back
+            );
+            println!(
                 "normals computed: {}, file normals: {:?}, uvs: {:?}",
                 report.normals_computed, report.file_normals, report.uvs
             );

@@ -82,7 +82,7 @@ pub use gltf::{
     write_glb_animation_with, write_gltf_with,
 };
 pub use materials::{FaceMaterials, load_face_materials};
-pub use normals::{compute_normals, compute_normals_into};
+pub use normals::{CANCELLED_RELATIVE, NormalScratch, compute_normals, compute_normals_into};
 pub use npy::{NpyArray, read_npy_f32, write_npy_f32, write_npy_frames};
 pub use obj::{SeamSplit, load_mesh_split_seams};
 pub use options::{
@@ -95,8 +95,8 @@ pub use report::{
 };
 pub use types::{Animation, Mesh};
 pub use validate::{
-    ZERO_AREA_RELATIVE, count_duplicate_positions, find_degenerate_triangles,
-    find_unreferenced_vertices,
+    RepeatedTriangles, ZERO_AREA_RELATIVE, count_duplicate_positions, count_repeated_triangles,
+    find_degenerate_triangles, find_unreferenced_vertices,
 };
 pub use vat::{
     VAT_MAX_HEIGHT, VAT_MAX_WIDTH, VatClip, VatReport, vat_companions, vat_layout, write_vat_with,

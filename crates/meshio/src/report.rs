@@ -3,6 +3,8 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
+use crate::RepeatedTriangles;
+
 /// The file format that was read.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SourceFormat {
@@ -157,6 +159,9 @@ pub struct LoadReport {
     /// Vertices whose position equals that of an earlier vertex bit for bit (`-0.0 == 0.0`):
     /// vertex count minus the number of distinct positions.
     pub duplicate_positions: usize,
+    /// Triangles over the same three vertices as another: repeats and back-to-back pairs
+    /// (as written, before any removal).
+    pub repeated_triangles: RepeatedTriangles,
     /// True when normals were computed rather than read from the file.
     pub normals_computed: bool,
     /// Normals stored in the file.

@@ -78,6 +78,49 @@ pub fn count_duplicate_positions(positions: &[Vec3]) -> usize {
     positions.len() - keys.len()
 }
 
+/// Triangles that repeat an earlier triangle's three vertices: `repeated` with the same
+/// winding (the same face twice), `back_to_back` pairs with opposite windings (a
+/// zero-thickness flap, whose normals cancel: see [`crate::compute_normals`]). A set of
+/// vertices written `e` times in one winding and `o` times in the other counts
+/// p = `min(e, o)` pairs, and the e + o − 2p triangles left over (all of one winding) less the
+/// first one, when no pair holds it already, as repeats; triangles with a repeated index are
+/// left to [`find_degenerate_triangles`].
+pub fn count_repeated_triangles(triangles: &[[u32; 3]]) -> RepeatedTriangles {
+    let mut keys: Vec<([u32; 3], bool)> = triangles
+        .iter()
+        .filter(|&&[a, b, c]| a != b && b != c && a != c)
+        .map(|&tri| {
+            // Rotate the smallest index first (keeps the winding), then compare the others.
+            let m = (0..3).min_by_key(|&i| tri[i]).unwrap_or(0);
+            let [a, b, c] = [tri[m], tri[(m + 1) % 3], tri[(m + 2) % 3]];
+            if b < c {
+                ([a, b, c], true)
+            } else {
+                ([a, c, b], false)
+            }
+        })
+        .collect();
+    keys.sort_unstable();
+    let mut found = RepeatedTriangles::default();
+    for run in keys.chunk_by(|x, y| x.0 == y.0) {
+        let even = run.iter().filter(|k| k.1).count();
+        let pairs = even.min(run.len() - even);
+        found.back_to_back += pairs;
+        let left = run.len() - 2 * pairs;
+        found.repeated += if pairs == 0 { left - 1 } else { left };
+    }
+    found
+}
+
+/// What [`count_repeated_triangles`] found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RepeatedTriangles {
+    /// Triangles equal to another, winding included, beyond the pairs below and the first.
+    pub repeated: usize,
+    /// Pairs of triangles over the same vertices with opposite windings.
+    pub back_to_back: usize,
+}
+
 fn referenced_mask(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<bool> {
     let mut used = vec![false; vertex_count];
     for &i in triangles.iter().flatten() {
@@ -211,6 +254,7 @@ pub(crate) fn finish_mesh(
     report.file_triangle_count = triangles.len();
     report.degenerate_triangles = find_degenerate_triangles(&positions, &triangles);
     report.duplicate_positions = count_duplicate_positions(&positions);
+    report.repeated_triangles = count_repeated_triangles(&triangles);
     if options.remove_degenerate && !report.degenerate_triangles.is_empty() {
         let mut degenerate = vec![false; triangles.len()];
         for d in &report.degenerate_triangles {
@@ -349,6 +393,7 @@ pub(crate) fn finish_animation(
         find_unreferenced_vertices(vertex_count, &animation.triangles)
     };
     report.duplicate_positions = count_duplicate_positions(first);
+    report.repeated_triangles = count_repeated_triangles(&animation.triangles);
     report.normals_computed = false;
     Ok((animation, report))
 }

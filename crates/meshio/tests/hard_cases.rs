@@ -479,8 +479,9 @@ fn degenerate_and_zero_area_triangles_are_reported_and_removed_on_request() {
         ]
     );
     assert_eq!(report.duplicate_positions, 1);
-    // v5 is only in a degenerate triangle: its normal is exactly zero (documented fallback).
-    assert_eq!(mesh.normals[5], Vec3::ZERO);
+    // v5 is only in a degenerate triangle: it takes its neighbours' (v0 and v1) normal, +z
+    // (the documented fallback).
+    assert_close(mesh.normals[5], Vec3::Z, 1e-6);
     let options = LoadOptions {
         remove_degenerate: true,
         remove_unreferenced: true,
@@ -514,6 +515,101 @@ fn only_degenerate_triangles_left_is_an_error_after_removal() {
         load_mesh(&path, &options),
         Err(MeshIoError::EmptyMesh { .. })
     ));
+}
+
+/// A quad in a tilted plane with a zero-thickness flap on its diagonal: the triangles
+/// [1, 3, 4] and [3, 1, 4] over the same vertices with opposite windings (70 such pairs in
+/// `bun_zipper_res3.ply`), its tip at (a, b) over the quad at height h.
+fn flap_mesh_at(a: f32, b: f32, h: f32) -> (Vec<Vec3>, Vec<[u32; 3]>, Vec3) {
+    let u = Vec3::new(1.0, 0.1, 0.3);
+    let v = Vec3::new(-0.2, 0.9, 0.7);
+    let at = |a: f32, b: f32| Vec3::new(0.13, -0.71, 0.37) + u * a + v * b;
+    let plane = u.cross(v).normalize();
+    let positions = vec![
+        at(0.0, 0.0),
+        at(1.0, 0.0),
+        at(1.0, 1.0),
+        at(0.0, 1.0),
+        at(a, b) + plane * h,
+    ];
+    let triangles = vec![[0, 1, 3], [1, 2, 3], [1, 3, 4], [3, 1, 4]];
+    (positions, triangles, plane)
+}
+
+fn flap_mesh() -> (Vec<Vec3>, Vec<[u32; 3]>, Vec3) {
+    flap_mesh_at(0.537, 0.411, 0.29)
+}
+
+#[test]
+fn back_to_back_flap_tip_takes_its_neighbours_normal_not_rounding_noise() {
+    // Tips at off-grid places: the flap's two normals cancel to exactly zero at some and to
+    // rounding noise (1e-16) at others, whose direction is arbitrary.
+    let tips = [
+        (0.134, 0.847, 0.764),
+        (0.255, 0.495, 0.449),
+        (0.652, 0.789, 0.094),
+        (0.722, 0.229, 0.945),
+        (0.901, 0.031, 0.025),
+        (0.541, 0.939, 0.381),
+        (0.537, 0.411, 0.29),
+    ];
+    for (a, b, h) in tips {
+        let (positions, triangles, plane) = flap_mesh_at(a, b, h);
+        for weighting in [NormalWeighting::Angle, NormalWeighting::Area] {
+            let normals = compute_normals(&positions, &triangles, weighting);
+            // The flap cancels on the quad's vertices: all four keep the plane's normal …
+            for n in &normals[..4] {
+                assert_close(*n, plane, 1e-6);
+            }
+            // … and the tip, whose own normals give no direction, takes theirs (v1 and v3).
+            assert_close(normals[4], plane, 1e-6);
+        }
+    }
+    let counted = meshio::count_repeated_triangles(&flap_mesh().1);
+    assert_eq!((counted.repeated, counted.back_to_back), (0, 1));
+}
+
+#[test]
+fn a_fin_of_back_to_back_pairs_fills_from_the_surface_inwards() {
+    let (mut positions, mut triangles, plane) = flap_mesh();
+    // Two more pairs: [3, 4, 5] beside the first flap, and [4, 5, 6], whose tip 6 touches
+    // only flap vertices — it has a normal only once 4 and 5 have one (a second round).
+    positions.push(positions[4] + Vec3::new(0.21, 0.17, -0.05));
+    positions.push(positions[4] + Vec3::new(0.08, 0.33, 0.19));
+    triangles.extend([[3, 4, 5], [4, 3, 5], [4, 5, 6], [5, 4, 6]]);
+    let normals = compute_normals(&positions, &triangles, NormalWeighting::Angle);
+    for n in &normals {
+        assert_close(*n, plane, 1e-6);
+    }
+    let counted = meshio::count_repeated_triangles(&triangles);
+    assert_eq!((counted.repeated, counted.back_to_back), (0, 3));
+}
+
+#[test]
+fn isolated_back_to_back_pair_has_no_normal() {
+    let (positions, _, _) = flap_mesh();
+    // The flap alone: every vertex's normals cancel and no neighbour has one to lend.
+    let normals = compute_normals(&positions, &[[1, 3, 4], [3, 1, 4]], NormalWeighting::Angle);
+    assert!(normals.iter().all(|n| *n == Vec3::ZERO), "{normals:?}");
+}
+
+#[test]
+fn repeated_triangles_and_back_to_back_pairs_are_told_apart_by_winding() {
+    // [1, 2, 0] is [0, 1, 2] rotated (a repeat), [2, 1, 0] and [0, 2, 1] are reversed: two
+    // windings of one vertex set, written 2 + 2 times, make two pairs; a repeated index is a
+    // degenerate triangle, not counted here.
+    let triangles = [
+        [0, 1, 2],
+        [1, 2, 0],
+        [2, 1, 0],
+        [0, 2, 1],
+        [3, 4, 5],
+        [0, 0, 1],
+    ];
+    let counted = meshio::count_repeated_triangles(&triangles);
+    assert_eq!((counted.repeated, counted.back_to_back), (0, 2));
+    let counted = meshio::count_repeated_triangles(&[[5, 6, 7], [6, 7, 5], [7, 5, 6], [7, 6, 5]]);
+    assert_eq!((counted.repeated, counted.back_to_back), (2, 1));
 }
 
 #[test]

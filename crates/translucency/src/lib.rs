@@ -22,6 +22,15 @@
 //!   object, SH reduction, light-space linear-distance map with one peeled layer and a
 //!   separable Gaussian, and eq. 12 per pixel added to the render crate's shared frame.
 //!
+//! **One thickness.** d is the distance from the light map's first surface to the shaded
+//! point, so everything in front of the point along the light counts as material — also a
+//! zero-thickness flap (a back-to-back triangle pair, which `cloth-vis inspect` counts) standing
+//! off the surface: its footprint on the surface behind it is attenuated as if the gap were
+//! filled, a small dark dash. `bun_zipper_res3.ply` shows a few (70 pairs from its
+//! decimation); with the pairs and repeats removed (3,711 of its 3,851 triangles kept) the
+//! same render loses them, and keeps only the small dark triangles where the coarse mesh
+//! folds over itself.
+//!
 //! # Example
 //! ```
 //! use glam::DVec3;

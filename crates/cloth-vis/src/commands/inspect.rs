@@ -160,14 +160,17 @@ fn report_lines(report: &LoadReport) -> Vec<String> {
     )];
     lines.push(format!(
         "as written: {}, {} ({}, {} fan-triangulated); \
-         unreferenced vertices: {}, degenerate triangles: {}, duplicate positions: {}",
+         unreferenced vertices: {}, degenerate triangles: {}, duplicate positions: {}, \
+         repeated triangles: {}, back-to-back triangle pairs: {}",
         counted(report.file_vertex_count, "vertex"),
         counted(report.file_face_count, "face"),
         counted(report.file_triangle_count, "triangle"),
         counted(report.polygons_triangulated, "polygon"),
         report.unreferenced_vertices.len(),
         report.degenerate_triangles.len(),
-        report.duplicate_positions
+        report.duplicate_positions,
+        report.repeated_triangles.repeated,
+        report.repeated_triangles.back_to_back
     ));
     if report.removed_triangles + report.removed_vertices > 0 {
         lines.push(format!(

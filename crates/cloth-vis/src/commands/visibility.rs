@@ -147,8 +147,9 @@ pub struct VisibilitySummary {
     pub directions: usize,
     /// Vertices per frame N.
     pub vertices: usize,
-    /// Vertices without a normal in the last frame — used by no triangle, or only by
-    /// degenerate ones: a_i is NaN for them (−1 in `.glb`), their rows of M 0.
+    /// Vertices without a normal in the last frame — used by no triangle, or neither their
+    /// triangles nor their neighbours give a direction (`meshio::compute_normals`): a_i is
+    /// NaN for them (−1 in `.glb`), their rows of M 0.
     pub unused: usize,
     /// Frames computed.
     pub frames: usize,
@@ -170,8 +171,8 @@ impl VisibilitySummary {
         let unused = match self.unused {
             0 => String::new(),
             n => format!(
-                "; {n} {} without a normal (no triangle, or only degenerate ones, uses them): \
-                 a_i = NaN (-1 in .glb)",
+                "; {n} {} without a normal (used by no triangle, or neither their triangles nor \
+                 their neighbours give a direction): a_i = NaN (-1 in .glb)",
                 if n == 1 { "vertex" } else { "vertices" }
             ),
         };
@@ -677,7 +678,8 @@ pub struct VisibilityArgs {
     /// [F, N, k] with --matrix, rows of unused vertices 0), .ply (one frame: colour, float
     /// `ao` = a_i, NaN for unused vertices) or .glb (one frame: linear float COLOR_0, float
     /// `_AO` = a_i, -1 for unused vertices). Unused: without a normal, because no triangle
-    /// (or only degenerate ones) uses them — the Stanford bunny has 1,113.
+    /// uses them (the Stanford bunny has 1,113) or neither their triangles nor their
+    /// neighbours give a direction.
     #[arg(long, short = 'o')]
     out: Option<PathBuf>,
     /// Write the matrix M (M_ij = n_i·l_j where vertex i sees direction j, else 0) instead of

@@ -85,14 +85,31 @@ pub fn base64(bytes: &[u8]) -> String {
     out
 }
 
-/// f64 area-weighted reference normal of vertex `v` (brute force over all triangles).
+/// Vertex `v`'s area-weighted normal in f64 by brute force over all triangles, straight from
+/// the definition in `meshio`'s normals module: its own triangles' sum, or, when that cancels,
+/// its neighbours' mean.
 pub fn reference_area_normal(positions: &[Vec3], triangles: &[[u32; 3]], v: u32) -> glam::DVec3 {
-    let mut sum = glam::DVec3::ZERO;
-    for t in triangles.iter().filter(|t| t.contains(&v)) {
-        let [a, b, c] = t.map(|i| positions[i as usize].as_dvec3());
-        sum += (b - a).cross(c - a);
+    let own = |v: u32| {
+        let (mut sum, mut weight) = (glam::DVec3::ZERO, 0.0);
+        for t in triangles.iter().filter(|t| t.contains(&v)) {
+            let [a, b, c] = t.map(|i| positions[i as usize].as_dvec3());
+            sum += (b - a).cross(c - a);
+            weight += (b - a).cross(c - a).length();
+        }
+        // The documented cancellation rule (meshio::CANCELLED_RELATIVE).
+        (sum.length() > meshio::CANCELLED_RELATIVE * weight).then(|| sum.normalize())
+    };
+    if let Some(n) = own(v) {
+        return n;
     }
-    sum.normalize_or_zero()
+    // The fallback: the mean of the neighbours' own normals, once per triangle corner.
+    let mut mean = glam::DVec3::ZERO;
+    for t in triangles.iter().filter(|t| t.contains(&v)) {
+        for &o in t.iter().filter(|&&o| o != v) {
+            mean += own(o).unwrap_or_default();
+        }
+    }
+    mean.normalize_or_zero()
 }
 
 /// An ASCII PLY with `x y z` vertices and `list uchar int` faces.

@@ -60,7 +60,7 @@ fn ambient_npy_keeps_vertex_order_with_nan_for_unused_vertices() {
     let line = summary.line();
     assert!(
         line.starts_with("visibility: 66 directions x 26 vertices in ")
-            && line.ends_with("; 1 vertex without a normal (no triangle, or only degenerate ones, uses them): a_i = NaN (-1 in .glb)"),
+            && line.ends_with("; 1 vertex without a normal (used by no triangle, or neither their triangles nor their neighbours give a direction): a_i = NaN (-1 in .glb)"),
         "{line}"
     );
     let array = meshio::read_npy_f32(&out).unwrap();
