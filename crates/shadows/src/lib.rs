@@ -72,5 +72,5 @@ pub use gpu::{
 };
 pub use ground::{GroundGrid, exact_ground_mask, ground_extrusion};
 pub use light::Light;
-pub use lod::{Hausdorff, LodLevel, LodTarget, caster_lod, hausdorff, simplify};
+pub use lod::{Hausdorff, LodLevel, LodTarget, caster_lod, connected_pieces, hausdorff, simplify};
 pub use view::exact_view_mask;

@@ -1,7 +1,7 @@
 //! The hard cases of the shadows issue, one named test each: the eye inside a volume; the near
 //! plane crossing a volume; open cloth (border edges); a light in a face's plane (n·l = 0);
 //! degenerate and duplicated triangles; the light inside the caster's bounding box; coplanar
-//! caster and receiver; a caster offset by 1e5. Masks are compared with exact rays away from
+//! caster and receiver; a caster offset by 1e5; a loose piece under a Hausdorff budget. Masks are compared with exact rays away from
 //! shadow boundaries (cells whose 3 × 3 neighbourhood is uniform); the GPU halves skip without
 //! an adapter and fail under `CI`.
 
@@ -485,4 +485,58 @@ fn self_shadowing_from_a_coarse_caster() {
     );
     assert_eq!(dark(&fixed), background, "the offset leaves acne");
     assert_eq!(lit(&fixed), lit(&full));
+}
+
+/// A loose piece far from the rest: a unit sphere with a small back-to-back triangle pair
+/// (a zero-thickness flake, the kind `dragon_vrip_res2.ply` carries six of) 0.5 above it.
+/// meshoptimizer collapses the flake to nothing at once, and its distance to the sphere
+/// (13 % of the diagonal) would then be the error of every coarse level, so a 1 % budget
+/// would keep nearly all the triangles. Under a Hausdorff budget the piece is kept whole.
+#[test]
+fn a_loose_piece_does_not_set_the_floor_of_a_hausdorff_budget() {
+    let (mut positions, mut triangles) = sphere(Vec3::ZERO, 1.0, 4);
+    let full_sphere = triangles.len();
+    let base = positions.len() as u32;
+    positions.extend([
+        Vec3::new(0.0, 1.5, 0.0),
+        Vec3::new(0.02, 1.5, 0.0),
+        Vec3::new(0.0, 1.5, 0.02),
+    ]);
+    triangles.extend([[base, base + 1, base + 2], [base, base + 2, base + 1]]);
+    let pieces = shadows::connected_pieces(positions.len(), &triangles);
+    assert!(pieces[..base as usize].iter().all(|&p| p == 0));
+    assert!(pieces[base as usize..].iter().all(|&p| p == 1));
+
+    // A fixed count lets the flake go: the count is the promise there.
+    let ratio = shadows::caster_lod(
+        &positions,
+        &triangles,
+        shadows::LodTarget::Ratio(0.05),
+        3000,
+        5,
+    )
+    .unwrap();
+    assert!(ratio.triangles.iter().all(|t| t[0] < base));
+    assert!(ratio.hausdorff.percent() > 10.0, "{:?}", ratio.hausdorff);
+
+    let level = shadows::caster_lod(
+        &positions,
+        &triangles,
+        shadows::LodTarget::HausdorffPercent(1.0),
+        3000,
+        5,
+    )
+    .unwrap();
+    assert!(level.hausdorff.percent() <= 1.0, "{:?}", level.hausdorff);
+    assert!(
+        level.triangles.len() < full_sphere / 4,
+        "{} of {} kept",
+        level.triangles.len(),
+        triangles.len()
+    );
+    let flake: Vec<_> = level.triangles.iter().filter(|t| t[0] >= base).collect();
+    assert_eq!(flake.len(), 2, "{flake:?}");
+    // The capped measurement the search uses gives the exact sampled distances.
+    let again = shadows::hausdorff(&positions, &triangles, &level.triangles, 3000, 5);
+    assert_eq!(again, level.hausdorff);
 }

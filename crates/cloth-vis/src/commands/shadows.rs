@@ -240,7 +240,7 @@ impl ShadowsArgs {
             None => GroundGrid::around(&mesh.positions, self.ground, self.grid),
         }
         .map_err(|e| invalid(&self.input, e.to_string()))?;
-        let (caster, lod_note) = match lod {
+        let (caster, lod_note, level) = match lod {
             Some(target) => {
                 step.set_message(format!(
                     "simplifying the caster's {} triangles (--lod {})",
@@ -260,9 +260,9 @@ impl ShadowsArgs {
                     mesh.triangles.len(),
                     level.hausdorff.percent()
                 );
-                (level.triangles, note)
+                (level.triangles.clone(), note, Some(level))
             }
-            None => (mesh.triangles.clone(), String::new()),
+            None => (mesh.triangles.clone(), String::new(), None),
         };
         let sides = match self.sides.as_str() {
             "one" => Sides::One,
@@ -303,7 +303,15 @@ impl ShadowsArgs {
         let unshadowable = nothing_casts(&mesh.positions, &light, grid.y);
         if let (Some(path), Some(gpu)) = (&self.render, &gpu) {
             step.set_message(format!("drawing {}", path.display()));
-            self.draw(path, gpu, &scene, mesh, (&grid, &mask), light, sides)?;
+            self.draw(
+                path,
+                gpu,
+                &scene,
+                (mesh, level),
+                (&grid, &mask),
+                light,
+                sides,
+            )?;
         }
         step.finish_and_clear();
         let shadowed = mask.iter().filter(|&&v| v > 0.0).count() as f64 / mask.len() as f64;
@@ -338,7 +346,7 @@ impl ShadowsArgs {
         path: &std::path::Path,
         gpu: &GpuContext,
         scene: &cloth_vis::Scene,
-        mut mesh: WorldObject,
+        (mut mesh, level): (WorldObject, Option<shadows::LodLevel>),
         (grid, mask): (&GroundGrid, &[f32]),
         light: Light,
         sides: Sides,
@@ -385,7 +393,9 @@ impl ShadowsArgs {
         let mut objects = vec![mesh, ground];
         let format = FrameFormat::for_context(gpu).with_depth(DepthConvention::ReversedInfinite);
         let mut renderer = Renderer::new(&gpu.device, format);
-        let mut stage = ShadowVolumeStage::new(&scene, gpu, &renderer, &objects)?;
+        // The mesh is object 0: its level is the one the mask used.
+        let levels: Vec<(usize, shadows::LodLevel)> = level.into_iter().map(|l| (0, l)).collect();
+        let mut stage = ShadowVolumeStage::with_levels(&scene, gpu, &renderer, &objects, &levels)?;
         stage.prepare(&scene, gpu, &mut objects)?;
         let meshes: Vec<DrawMesh> = objects
             .iter()
