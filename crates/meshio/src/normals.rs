@@ -22,12 +22,11 @@
 //! its triangles that have one): a flap's tip is shaded like the surface the flap grows from.
 //! Rounds repeat while they lend a normal, so a fin of several back-to-back pairs fills from
 //! the surface inwards. A vertex that no triangle references, or whose whole connected part
-//! has no normal (an isolated back-to-back pair), gets the zero vector: on
-//! `dragon_vrip_res2.ply` (1,408 back-to-back pairs) 387 vertices had none before the fallback
-//! counted noise as no direction — and more pointed anywhere — and 54 have none after it, the
-//! 43 no triangle uses and 11 in loose back-to-back pieces. Zero rather than an invented direction
-//! (+Z) so that a consumer can tell "no normal" from a real one; every other output is finite
-//! and unit length.
+//! has no normal (an isolated back-to-back pair), gets the zero vector. On
+//! `dragon_vrip_res2.ply` (1,408 back-to-back pairs) 387 vertices had no normal before this
+//! rule, and others a noise direction; 54 have none now: the 43 no triangle uses and 11 in
+//! loose back-to-back pieces. Zero rather than an invented direction (+Z), so that a consumer
+//! can tell "no normal" from a real one; every other output is finite and unit length.
 
 use glam::{DVec3, Vec3};
 
