@@ -28,8 +28,8 @@
 //! off the surface: its footprint on the surface behind it is attenuated as if the gap were
 //! filled, a small dark dash. `bun_zipper_res3.ply` shows a few (70 pairs from its
 //! decimation); with the pairs and repeats removed (3,711 of its 3,851 triangles kept) the
-//! same render loses them, and keeps only the small dark triangles where the coarse mesh
-//! folds over itself.
+//! same render loses them. It keeps a few small dark triangles, which neither the pairs nor
+//! the mesh's 10 inconsistently wound triangles explain (removing those too leaves them).
 //!
 //! # Example
 //! ```
