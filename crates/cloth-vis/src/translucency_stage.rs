@@ -8,7 +8,10 @@
 //!
 //! * A **point or directional light** gives E_t = F_t(η, n·l) E max(0, n·l) (unshadowed) and
 //!   also draws its own direct term ρ/π E max(0, n·l) into the objects' vertex radiance — the
-//!   paper's "direct lighting" beside "subsurface scattering" (Figs. 10–11).
+//!   paper's "direct lighting" beside "subsurface scattering" (Figs. 10–11). The direct term
+//!   is per vertex, so a vertex whose faces fold or crease away from the light darkens the
+//!   triangles around it (a few on the decimated `bun_zipper_res3.ply`; see the
+//!   `translucency` crate's docs).
 //! * **`environment = true`** takes the scene's lighting (self-shadowed when `self-shadowing`
 //!   runs): E_t = (π/ρ) c_i · (1 − R0)·20/21, the vertex radiance turned back into irradiance
 //!   and scaled by Schlick's transmittance averaged over the cosine-weighted hemisphere; the

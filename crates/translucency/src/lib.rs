@@ -28,8 +28,12 @@
 //! off the surface: its footprint on the surface behind it is attenuated as if the gap were
 //! filled, a small dark dash. `bun_zipper_res3.ply` shows a few (70 pairs from its
 //! decimation); with the pairs and repeats removed (3,711 of its 3,851 triangles kept) the
-//! same render loses them. It keeps a few small dark triangles, which neither the pairs nor
-//! the mesh's 10 inconsistently wound triangles explain (removing those too leaves them).
+//! same render loses them. The few small dark triangles `cloth-vis translucency` leaves on it
+//! under a point light are not this crate's term: they are the direct term ρ/π E max(0, n·l)
+//! the command adds per vertex (Gouraud), dark at about five vertices whose own faces fold
+//! back (151–180° between face normals) or crease (61–66°), so that their angle-weighted
+//! normal faces away from a light their neighbours face. With eq. 12 replaced by a constant
+//! they remain; with the direct term left out they are gone.
 //!
 //! # Example
 //! ```
