@@ -153,6 +153,9 @@ fn report_lines(report: &LoadReport) -> Vec<String> {
         status(&report.file_normals),
         if report.normals_computed {
             " (computed from the triangles)"
+        } else if report.file_normals == AttributeStatus::Loaded {
+            // The scene path recomputes them in world space, every frame (`WorldObject`).
+            " (lighting and visibility use normals computed from the triangles instead, per frame)"
         } else {
             ""
         },

@@ -115,3 +115,27 @@ fn clip_selects_a_gltf_animation_by_name_or_index() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("Fox.glb") && err.contains("\"Walk\""), "{err}");
 }
+
+#[test]
+fn inspect_says_that_loaded_normals_are_not_the_ones_lit() {
+    let dir = tempfile::tempdir().unwrap();
+    // One normal per vertex (no hard edge): the loader keeps them.
+    let obj = dir.path().join("with_normals.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n",
+    )
+    .unwrap();
+    let s = String::from_utf8(cli(&["inspect", text(&obj)]).stdout).unwrap();
+    assert!(
+        s.contains("normals: loaded (lighting and visibility use normals computed from the triangles instead, per frame)"),
+        "{s}"
+    );
+    let bare = dir.path().join("bare.obj");
+    std::fs::write(&bare, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let s = String::from_utf8(cli(&["inspect", text(&bare)]).stdout).unwrap();
+    assert!(
+        s.contains("normals: none in the file (computed from the triangles);"),
+        "{s}"
+    );
+}
