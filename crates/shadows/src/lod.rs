@@ -252,7 +252,7 @@ pub fn connected_pieces(vertex_count: usize, triangles: &[[u32; 3]]) -> Vec<u32>
 /// none ends the test. Only the level chosen is measured in full. On
 /// `cloth-vis shadows dragon_vrip_res2.ply --lod 0.5%` (two cores, mask included) that took
 /// the search from 14 levels, six of them measured in full at 0.9 s each, and 8.7 s in all,
-/// to 11 levels and 3.3 s, for 8,224 triangles at 0.466 % instead of 8,192 (it took 9.9 s
+/// to 11 levels and 3.2 s, for 8,224 triangles at 0.466 % instead of 8,192 (it took 9.9 s
 /// to keep 195,000 when the loose pieces vanished).
 ///
 /// # Errors
