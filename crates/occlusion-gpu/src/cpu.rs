@@ -93,7 +93,19 @@
 //! leave 0.62× the trace, the one ceiling found beyond the 1.46× needed; but the previous
 //! Morton neighbour's blocker in the same direction (the single rays' shadow cache) blocks
 //! only 43 k of the 716 k (6 %: 623 k are blocked by another triangle, 50 k find no
-//! neighbour's), too few to pay for the test on every lane.
+//! neighbour's), too few to pay for the test on every lane. Its blocker's *subtree* catches
+//! more and still does not pay (exact, M's hash unchanged; bunny at k = 258, medians of 9,
+//! against 190–193 ms in the same session): each lane whose ray the previous Morton
+//! neighbour's ray in the same direction found blocked (686 k) first walked alone from the
+//! blocking triangle's leaf, or its ancestor 1 / 2 / 3 / 4 / 6 / 8 levels up, then the fan
+//! traced the rest. The walks caught 150 / 219 / 287 / 352 / 411 / 509 / 570 k of them (22
+//! to 83 %) and the call took 217 / 207 / 206 / 209 / 207 / 220 / 238 ms. A lane taken out
+//! of a fan saves work only where that empties its group of eight or spares a lone walk (the
+//! oracle above removed every occluded lane at once), and the caught ones are, presumably,
+//! those the near-first order reaches early; the 686 k extra walks cost more. The lanes that
+//! share a subtree traced from it together as one fan instead took 208–229 ms (545 k such
+//! traversals for the 686 k lanes at two levels up: a fan's neighbouring directions have
+//! different blockers).
 //!
 //! Nor does the build: fat link-time optimisation with one codegen unit (the release profile
 //! leaves both at Cargo's defaults) traced the bunny at k = 66 / 258 in 0.99–1.01× the time

@@ -23,7 +23,10 @@
 //!   box on the same side of the slab is dropped. A surface patch is much thinner than its
 //!   box, and the rays that graze the surface near their origin cross the boxes of the
 //!   patches beside it: on the bunny at k = 258 leaf slabs alone took 5 % off, slabs up to
-//!   128 / 512 / 1,024 / 4,096 triangles 12 / 16 / 17 / 17 %;
+//!   128 / 512 / 1,024 / 4,096 triangles 12 / 16 / 17 / 17 %. They are thin nearly everywhere:
+//!   only 949 of the bunny's 32,363 are as much as half their box's extent along their normal,
+//!   and leaving out the slabs of nodes where that ratio exceeds 0.3 / 0.5 / 0.7 / 0.9 (3,295 /
+//!   949 / 265 / 39 nodes) left the time unchanged (189–196 ms against 189–192, k = 258);
 //! * where a subtree is entered by [`single::ALONE`] = 4 live lanes or fewer, each walks it
 //!   alone (the `single` module): lanes diverge with depth, and on the bunny at k = 258
 //!   44 % of the internal nodes visited held one live lane (55 % two or fewer, 70 % eight or
