@@ -329,19 +329,70 @@ impl EdgeTriangle {
 }
 
 /// The scene's BVH with triangles stored in BVH leaf order.
+///
+/// `obvhs`'s CWBVH node test clamps a box's entry to t ≥ 10⁻⁴ in the ray's own units (its
+/// `EPSILON`), whatever the ray's `tmin`, so hits closer than 10⁻⁴ · |d| were lost:
+/// * with unit directions, every occluder within 10⁻⁴ scene units — 3.8 × 10⁻⁴ of the bunny's
+///   diagonal in metres, everything in a scene 10⁻³ across;
+/// * with a point light's l − p (length 10⁵), every occluder within 10 units.
+///
+/// Its debug builds also check the quantised boxes against an absolute 10⁻⁵, which f32
+/// rounding exceeds once coordinates reach the hundreds.
+///
+/// So the tracer works in its own coordinates:
+/// * the scene is scaled by the power of two that brings its diagonal into (8, 16];
+/// * each ray's direction is scaled by the power of two that brings its largest component into
+///   (0.5, 1] — a unit direction is left as it is;
+/// * `t` and `max_t` follow.
+///
+/// Scaling by a power of two commutes with f32 rounding (far from overflow and subnormals), so
+/// every Möller–Trumbore decision is bit for bit the one in the caller's coordinates. So is
+/// every box test of a unit direction: each slab's t scales with the scene's power of two, even
+/// a zero component's, whose inverse `obvhs` clamps to ±1/ε (a direction scaled to [1, 2)
+/// instead halved the margin such a ray needs inside a slab, and 6 more of the 73 k entries of
+/// `matches_brute_force_on_sphere_over_plane` flipped, all on a grid edge).
+///
+/// What changes:
+/// * the clamp now falls at 6–12 × 10⁻⁶ of the diagonal at any scale, about a tenth of the
+///   rays' offset from the surface ([`DEFAULT_OFFSET_RELATIVE`]);
+/// * the debug check holds at any scale.
+///
+/// The fans' own traversal has no such clamp.
 pub(crate) struct CpuTracer {
     bvh: CwBvh,
     triangles: Vec<EdgeTriangle>,
+    /// The power of two the scene's centred coordinates are multiplied by.
+    scale: f32,
+}
+
+/// 2^`e` as an f32, exactly (`e` clamped to the normal range).
+fn power_of_two(e: i32) -> f32 {
+    f32::from_bits(((e.clamp(-126, 127) + 127) as u32) << 23)
+}
+
+/// The power of two that brings a scene of diagonal `diagonal` to a diagonal in (8, 16] (1
+/// for an empty or degenerate scene).
+fn tracer_scale(diagonal: f32) -> f32 {
+    if diagonal > 0.0 && diagonal.is_finite() {
+        power_of_two(4 - diagonal.log2().ceil() as i32)
+    } else {
+        1.0
+    }
 }
 
 impl CpuTracer {
     /// Builds the BVH over all scene triangles (degenerate ones included: they never hit).
     pub(crate) fn new(prepared: &Prepared) -> Self {
-        let tris = scene_triangles(prepared);
+        let scale = tracer_scale(prepared.diagonal);
+        let mut tris = scene_triangles(prepared);
+        for t in &mut tris {
+            (t.v0, t.v1, t.v2) = (t.v0 * scale, t.v1 * scale, t.v2 * scale);
+        }
         if tris.is_empty() {
             return Self {
                 bvh: CwBvh::default(),
                 triangles: Vec::new(),
+                scale,
             };
         }
         let bvh = build_cwbvh_from_tris(
@@ -361,7 +412,31 @@ impl CpuTracer {
                 }
             })
             .collect();
-        Self { bvh, triangles }
+        Self {
+            bvh,
+            triangles,
+            scale,
+        }
+    }
+
+    /// A ray in the tracer's coordinates: the origin scaled as the scene, the direction by
+    /// the power of two that brings its largest component into (0.5, 1], `max_t` to match (a
+    /// product past f32's range stays finite for a finite `max_t`).
+    #[inline(always)]
+    fn scaled(&self, origin: Vec3A, direction: Vec3A, max_t: f32) -> (Vec3A, Vec3A, f32) {
+        let largest = direction.abs().max_element();
+        if !(largest > 0.0 && largest.is_finite()) {
+            // A zero or non-finite direction meets nothing (Möller–Trumbore's det is 0 or NaN).
+            return (origin * self.scale, direction, max_t);
+        }
+        let e = largest.log2().ceil() as i32;
+        let t_scale = self.scale * power_of_two(e);
+        let max_t = if max_t.is_finite() {
+            (max_t * t_scale).min(f32::MAX)
+        } else {
+            max_t
+        };
+        (origin * self.scale, direction * power_of_two(-e), max_t)
     }
 
     /// Whether a ray from `origin` towards `direction` meets no triangle before `max_t`
@@ -376,6 +451,7 @@ impl CpuTracer {
         max_t: f32,
         cache: &mut u32,
     ) -> bool {
+        let (origin, direction, max_t) = self.scaled(origin, direction, max_t);
         if let Some(t) = self.triangles.get(*cache as usize)
             && t.intersect(origin, direction) < max_t
         {

@@ -92,7 +92,9 @@ impl RayCaster {
 
     /// Whether the ray `origin + t·direction`, 0 < t < `max_distance` (centred coordinates;
     /// `direction` need not be unit, `t` is in its units), meets a triangle. `f32::INFINITY`
-    /// asks for any hit at all.
+    /// asks for any hit at all. The answer does not depend on the scene's scale or on the
+    /// direction's length: a point light's `l − p` 10¹⁵ long finds an occluder next to `p`
+    /// (the tracer's power-of-two scaling, see `CpuTracer`).
     pub fn occluded(
         &self,
         origin: Vec3,

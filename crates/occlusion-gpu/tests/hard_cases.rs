@@ -1,11 +1,12 @@
-//! Named adversarial cases (DESIGN.md "Hard cases stay numerically stable").
+//! Named adversarial cases (DESIGN.md "Hard cases stay numerically stable"), among them near
+//! occluders at any scene scale and direction length (`RayCaster`'s single rays).
 
 mod common;
 
 use common::*;
 use glam::{DVec3, Mat4, Vec3};
 use lightsphere::Lightsphere;
-use occlusion_gpu::{Scene, SceneObject, VisibilityEngine, VisibilityParams};
+use occlusion_gpu::{RayCaster, Scene, SceneObject, VisibilityEngine, VisibilityParams};
 
 fn cpu_ambient(scene: &Scene, level: u32) -> Vec<f32> {
     VisibilityEngine::cpu(VisibilityParams::default())
@@ -262,6 +263,61 @@ fn offsets_and_scales_do_not_change_results() {
             mean < 2e-3 && share < 0.01,
             "{placement}: mean {mean}, share {share}"
         );
+    }
+}
+
+/// `RayCaster::occluded` (the single-ray path: the shadows and hemicube exact references)
+/// finds an occluder 10⁻⁴ of the scene's diagonal away at any scene scale and any direction
+/// length. `obvhs`'s CWBVH culls boxes entered before t = 10⁻⁴ in the ray's units: before the
+/// tracer's power-of-two scaling, a scene 10⁻³ across or a direction 10⁵ long (a point light's
+/// l − p) lost every near occluder.
+#[test]
+fn near_occluders_at_any_scale_and_direction_length() {
+    for scale in [1e-9f32, 1e-6, 1e-3, 1.0, 1e3, 1e6, 1e9] {
+        // A square at y = 0 and a second one 10 above it: the diagonal is about 10.
+        let square = |y: f32| {
+            [
+                [-1.0, y, -1.0],
+                [1.0, y, -1.0],
+                [1.0, y, 1.0],
+                [-1.0, y, 1.0],
+            ]
+        };
+        let positions: Vec<Vec3> = [square(0.0), square(10.0)]
+            .concat()
+            .into_iter()
+            .map(|p| Vec3::from_array(p) * scale)
+            .collect();
+        let triangles = vec![[0, 2, 1], [0, 3, 2], [4, 6, 5], [4, 7, 6]];
+        let scene = Scene::single(positions, vec![Vec3::Y; 8], triangles).unwrap();
+        let caster = RayCaster::new(&scene).unwrap();
+        // 1e-3 below the lower square (1e-4 of the diagonal), towards it and away from it.
+        let below = DVec3::new(0.1, -1e-3, 0.2) * f64::from(scale);
+        let origin = caster.centred(below);
+        let up = Vec3::new(0.3, 1.0, -0.2).normalize();
+        let mut cache = Default::default();
+        for length in [1e-6f32, 1e-3, 1.0, 1e3, 1e5, 1e7] {
+            let d = up * length;
+            let case = format!("scale {scale:e}, |d| {length:e}");
+            assert!(
+                caster.occluded(origin, d, f32::INFINITY, &mut cache),
+                "{case}: up"
+            );
+            assert!(
+                !caster.occluded(origin, -d, f32::INFINITY, &mut cache),
+                "{case}: down"
+            );
+            // The hit is at t = 1e-3 · scale / (d_y) in d's units: max_t on either side of it.
+            let t_hit = 1e-3 * scale / d.y;
+            assert!(
+                caster.occluded(origin, d, 2.0 * t_hit, &mut cache),
+                "{case}: 2 t"
+            );
+            assert!(
+                !caster.occluded(origin, d, 0.5 * t_hit, &mut cache),
+                "{case}: t / 2"
+            );
+        }
     }
 }
 
