@@ -215,7 +215,7 @@ fn lod_chain(
             let mut volume = ShadowVolume::new();
             let params = VolumeParams {
                 sides: Sides::Two,
-                extrusion: Extrusion::Finite(shadows::ground_extrusion(&positions, &grid, light)),
+                extrusion: Extrusion::Finite(shadows::ground_extrusion(&positions, &grid)),
                 origin: grid.centre(),
                 offset: 0.0,
             };

@@ -78,7 +78,7 @@ fn bench(c: &mut Criterion) {
             let mut volume = ShadowVolume::new();
             let params = VolumeParams {
                 sides: Sides::Two,
-                extrusion: Extrusion::Finite(ground_extrusion(&positions, &grid, &light)),
+                extrusion: Extrusion::Finite(ground_extrusion(&positions, &grid)),
                 origin: grid.centre(),
                 offset: 0.0,
             };

@@ -398,7 +398,7 @@ pub fn stencil_ground_mask(
     let mut volume = ShadowVolume::new();
     let params = VolumeParams {
         sides,
-        extrusion: Extrusion::Finite(ground_extrusion(positions, grid, light)),
+        extrusion: Extrusion::Finite(ground_extrusion(positions, grid)),
         origin: grid.centre(),
         ..Default::default()
     };

@@ -96,20 +96,21 @@ impl GroundGrid {
     }
 }
 
-/// The finite extrusion a ground mask needs: twice the diagonal of the box around the caster,
-/// the ground's extent and a point light, so every volume reaches past the plane wherever the
-/// grid can see it.
-pub fn ground_extrusion(positions: &[Vec3], grid: &GroundGrid, light: &Light) -> f64 {
+/// The finite extrusion a ground mask needs: twice the diagonal of the box around the caster
+/// and the ground's extent. A grid point in shadow lies on the ray from a caster point away
+/// from the light, and both lie in that box, so every volume reaches past the plane wherever
+/// the grid can see it, wherever the light is.
+///
+/// The light's position stays out of the box on purpose: a point light 1e7 away made the
+/// volume 1e7 long, and its f32 vertices and the mask's depth range (which spans them) lost
+/// the caster's scale — the mask emptied (the `a_distant_point_light` hard case).
+pub fn ground_extrusion(positions: &[Vec3], grid: &GroundGrid) -> f64 {
     let [x0, z0, x1, z1] = grid.extent;
     let mut lo = DVec3::new(x0, grid.y, z0);
     let mut hi = DVec3::new(x1, grid.y, z1);
     for p in positions {
         lo = lo.min(p.as_dvec3());
         hi = hi.max(p.as_dvec3());
-    }
-    if let Light::Point(l) = light {
-        lo = lo.min(*l);
-        hi = hi.max(*l);
     }
     2.0 * (hi - lo).length().max(1e-9)
 }

@@ -1,7 +1,8 @@
 //! The hard cases of the shadows issue, one named test each: the eye inside a volume; the near
 //! plane crossing a volume; open cloth (border edges); a light in a face's plane (n·l = 0);
 //! degenerate and duplicated triangles; the light inside the caster's bounding box; coplanar
-//! caster and receiver; a caster offset by 1e5; a loose piece under a Hausdorff budget. Masks are compared with exact rays away from
+//! caster and receiver; a caster offset by 1e5; a loose piece under a Hausdorff budget; a
+//! distant point light (1e4 to 1e15 away). Masks are compared with exact rays away from
 //! shadow boundaries (cells whose 3 × 3 neighbourhood is uniform); the GPU halves skip without
 //! an adapter and fail under `CI`.
 
@@ -220,6 +221,33 @@ fn degenerate_and_duplicated_triangles() {
     assert!(
         stats.casting_faces == base.casting_faces || stats.casting_faces == base.casting_faces + 2
     );
+}
+
+#[test]
+fn a_distant_point_light() {
+    // A point light far away casts the directional light's shadow, by every method. Two
+    // things followed the light's distance and broke: the exact rays (direction l − p, t in
+    // its units) lost every occluder entered before t = 1e-4 in obvhs's CWBVH, from 1e4 on
+    // (0 % shadowed from 1e5); the volume's finite extrusion spanned the light, so from ~1e7
+    // its f32 vertices, and the stencil's depth range over them, lost the caster's scale.
+    let (positions, triangles) = cube(Vec3::new(0.0, 1.0, 0.0), 0.5);
+    let towards = DVec3::new(1.0, 1.0, 0.3).normalize();
+    let grid = GroundGrid::new(0.0, [-3.0, -3.0, 3.0, 3.0], 96).unwrap();
+    let directional =
+        exact_ground_mask(&positions, &triangles, &Light::Directional(towards), &grid).unwrap();
+    let share = shadowed_share(&directional);
+    assert!(share > 0.02, "the cube's shadow lies on the grid: {share}");
+    for distance in [1e4, 1e5, 1e7, 1e9, 1e15] {
+        let light = Light::Point(DVec3::new(0.0, 1.0, 0.0) + towards * distance);
+        let name = format!("point light at {distance:e}");
+        let exact = agree_everywhere(&name, &positions, &triangles, &light, Sides::Two, &grid);
+        let (far, near, boundary) = compare(&directional, &exact, grid.n);
+        assert_eq!(far, 0, "{name}: differs from the directional light");
+        assert!(
+            near * 10 <= boundary.max(10),
+            "{name}: {near} of {boundary}"
+        );
+    }
 }
 
 #[test]

@@ -85,7 +85,7 @@ pub fn winding_mask(
     let mut volume = ShadowVolume::new();
     let params = VolumeParams {
         sides,
-        extrusion: Extrusion::Finite(shadows::ground_extrusion(positions, grid, light)),
+        extrusion: Extrusion::Finite(shadows::ground_extrusion(positions, grid)),
         origin: grid.centre(),
         ..Default::default()
     };
