@@ -160,6 +160,25 @@ fn translucency_without_a_light_is_refused_before_any_work() {
         err.to_string().contains("translucency.material") && err.to_string().contains("jade"),
         "{err}"
     );
+    // A finite light beyond the world's bound is refused with the bound, not as "not finite".
+    for light in ["position = [1e30, 0, 0]", "direction = [0, 0, 0]"] {
+        let text = format!(
+            "effects = [\"translucency\"]\n{CLOTH}\n[translucency]\nlight = {{ {light} }}\n"
+        );
+        let err = Plan::for_scene(&scene(&text, dir.path()))
+            .unwrap_err()
+            .to_string();
+        let key = light.split(' ').next().unwrap();
+        assert!(
+            err.contains(&format!("translucency.light.{key}")) && err.contains("1e15"),
+            "{light}: {err}"
+        );
+        assert_eq!(
+            err.contains("non-zero"),
+            key == "direction",
+            "{light}: {err}"
+        );
+    }
 }
 
 #[test]

@@ -153,12 +153,16 @@ impl Scene {
                     ));
                 }
             }
+            let bound = crate::inputs::MAX_WORLD_COORDINATE;
             if let Some(p) = l.position
-                && !p.iter().all(|v| v.is_finite() && v.abs() <= 1e15)
+                && !p.iter().all(|v| v.is_finite() && (v.abs() as f32) <= bound)
             {
                 return Err(self.invalid(
                     &format!("{key}.position"),
-                    format!("{p:?} must be finite (|x| ≤ 1e15)"),
+                    format!(
+                        "{p:?}: every coordinate must be finite with |x| ≤ {bound:e} \
+                         (MAX_WORLD_COORDINATE)"
+                    ),
                 ));
             }
             let power = match (l.direction.is_some(), l.position.is_some()) {

@@ -226,12 +226,22 @@ impl Scene {
         let directional = (l.direction, l.irradiance, "direction", "irradiance");
         for (place, power, place_key, power_key) in [point, directional] {
             let Some(v) = place else { continue };
-            if !v.iter().all(|c| c.is_finite() && c.abs() <= 1e15)
+            let bound = crate::inputs::MAX_WORLD_COORDINATE;
+            // Compared as the f32 the stages use.
+            if !v.iter().all(|c| c.is_finite() && (c.abs() as f32) <= bound)
                 || v == [0.0; 3] && place_key == "direction"
             {
                 return Err(self.invalid(
                     &format!("translucency.light.{place_key}"),
-                    format!("{v:?} must be finite (and a direction non-zero)"),
+                    format!(
+                        "{v:?}: every coordinate must be finite with |x| ≤ {bound:e} \
+                         (MAX_WORLD_COORDINATE){}",
+                        if place_key == "direction" {
+                            ", and the direction non-zero"
+                        } else {
+                            ""
+                        }
+                    ),
                 ));
             }
             match power {
