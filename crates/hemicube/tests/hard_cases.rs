@@ -217,57 +217,80 @@ fn point_light_exactly_in_the_tangent_plane() {
     assert!(maps.layout().pixel_of(Vec3::new(1.0, 0.0, 0.0)).is_some());
 }
 
+/// A probe vertex at the origin facing up under a 2 × 2 roof one unit above it: its maps at
+/// hemicube resolution `res`, its position and the scene's ray caster.
+struct UnderARoof {
+    maps: VisibilityMaps,
+    positions: Vec<Vec3>,
+    caster: RayCaster,
+}
+
+impl UnderARoof {
+    fn new(res: u32) -> Self {
+        let roof = sheet(
+            Vec3::new(-1.0, 1.0, 1.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, -2.0),
+            1,
+        );
+        let probe = probe(Vec3::ZERO, Vec3::Y);
+        let positions = probe.positions.clone();
+        let scene = scene(probe, &[roof]);
+        let (maps, _) = build_with_rays(
+            &scene,
+            layout(Model::Hemicube { res }),
+            &BuildParams::default(),
+        )
+        .unwrap();
+        let caster = RayCaster::new(&scene).unwrap();
+        Self {
+            maps,
+            positions,
+            caster,
+        }
+    }
+
+    /// The probe's radiance (ρ = 1) under `light`, its visibility tested by `visibility`.
+    fn radiance(&self, light: PointLight, visibility: PointVisibility) -> Vec3 {
+        let mut radiance = vec![Vec3::ZERO; self.maps.len()];
+        add_point_lights(
+            &mut radiance,
+            &self.maps,
+            &self.positions,
+            Vec3::ONE,
+            &PointLighting {
+                lights: &[light],
+                visibility,
+                caster: Some(&self.caster),
+                offset_relative: BuildParams::default().offset_relative,
+            },
+        );
+        radiance[0]
+    }
+}
+
 #[test]
 fn distant_point_light_behind_a_roof() {
     // The exact light test casts l − p, whose length is the light's distance: before the ray
     // caster's power-of-two scaling, obvhs's CWBVH lost every occluder before t = 1e-4 of it,
     // so a roof 1 above a vertex stopped shading a light 1e4 away.
-    let roof = sheet(
-        Vec3::new(-1.0, 1.0, 1.0),
-        Vec3::new(2.0, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, -2.0),
-        1,
-    );
-    let probe = probe(Vec3::ZERO, Vec3::Y);
-    let positions = probe.positions.clone();
-    let scene = scene(probe, &[roof]);
-    let (maps, _) = build_with_rays(
-        &scene,
-        layout(Model::Hemicube { res: 16 }),
-        &BuildParams::default(),
-    )
-    .unwrap();
-    let caster = RayCaster::new(&scene).unwrap();
-    let radiance = |light: PointLight| {
-        let mut radiance = vec![Vec3::ZERO; maps.len()];
-        add_point_lights(
-            &mut radiance,
-            &maps,
-            &positions,
-            Vec3::ONE,
-            &PointLighting {
-                lights: &[light],
-                visibility: PointVisibility::Ray,
-                caster: Some(&caster),
-                offset_relative: BuildParams::default().offset_relative,
-            },
-        );
-        radiance[0]
-    };
+    let roof = UnderARoof::new(16);
     // Beside the roof (the ray leaves under its edge): (ρ/π) I cos θ / r² = cos θ with
     // I = π r².
     let beside = Vec3::new(0.98, 0.2, 0.0).normalize();
     for distance in [1e2f32, 1e4, 1e6] {
         let intensity = Vec3::splat(PI as f32 * distance * distance);
-        let above = radiance(PointLight {
+        let above = PointLight {
             position: Vec3::new(0.0, distance, 0.0),
             intensity,
-        });
+        };
+        let above = roof.radiance(above, PointVisibility::Ray);
         assert_eq!(above, Vec3::ZERO, "light {distance:e} above the roof");
-        let lit = radiance(PointLight {
+        let lit = PointLight {
             position: beside * distance,
             intensity,
-        });
+        };
+        let lit = roof.radiance(lit, PointVisibility::Ray);
         assert!(
             (lit - Vec3::splat(beside.y)).abs().max_element() < 1e-3 * beside.y,
             "light {distance:e} beside the roof: {lit}"
@@ -279,49 +302,18 @@ fn distant_point_light_behind_a_roof() {
 fn point_light_between_the_vertex_and_its_occluder() {
     // The seed's limitation: a map records whether the *environment* is seen. A light under a
     // roof, above the vertex, is reported occluded by the map; the exact ray sees it lit.
-    let roof = sheet(
-        Vec3::new(-1.0, 1.0, 1.0),
-        Vec3::new(2.0, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, -2.0),
-        1,
-    );
-    let probe = probe(Vec3::ZERO, Vec3::Y);
-    let positions = probe.positions.clone();
-    let scene = scene(probe, &[roof]);
-    let (maps, _) = build_with_rays(
-        &scene,
-        layout(Model::Hemicube { res: 32 }),
-        &BuildParams::default(),
-    )
-    .unwrap();
-    let caster = RayCaster::new(&scene).unwrap();
+    let roof = UnderARoof::new(32);
     let light = PointLight {
         position: Vec3::new(0.0, 0.5, 0.0),
         intensity: Vec3::splat(PI as f32),
     };
-    let lit = |visibility| {
-        let mut radiance = vec![Vec3::ZERO; maps.len()];
-        add_point_lights(
-            &mut radiance,
-            &maps,
-            &positions,
-            Vec3::ONE,
-            &PointLighting {
-                lights: &[light],
-                visibility,
-                caster: Some(&caster),
-                offset_relative: BuildParams::default().offset_relative,
-            },
-        );
-        radiance[0]
-    };
     assert_eq!(
-        lit(PointVisibility::Map),
+        roof.radiance(light, PointVisibility::Map),
         Vec3::ZERO,
         "the map's (wrong) answer"
     );
     // (ρ/π) I cos / r² = 1 · π · 1 / (π · 0.25) = 4.
-    let exact = lit(PointVisibility::Ray);
+    let exact = roof.radiance(light, PointVisibility::Ray);
     assert!(
         (exact - Vec3::splat(4.0)).abs().max_element() < 1e-3,
         "{exact}"
