@@ -288,8 +288,8 @@ mod gpu {
         }
         // A 100 mm slab 10 mm thick in millimetre units, 10⁵ mm from the origin (f32 world
         // positions there resolve 8 µm; uncentred light distances would lose d entirely).
-        let (at_origin, n0) = slab_frame_against_cpu(DVec3::ZERO, 1000.0, false);
-        let (offset, n1) = slab_frame_against_cpu(DVec3::new(1e5, -1e5, 1e5), 1000.0, false);
+        let (at_origin, n0) = slab_frame_against_cpu(DVec3::ZERO, 1000.0, None);
+        let (offset, n1) = slab_frame_against_cpu(DVec3::new(1e5, -1e5, 1e5), 1000.0, None);
         eprintln!(
             "at the origin: {at_origin:.2e} over {n0} pixels; offset by 1e5: {offset:.2e} over {n1}"
         );

@@ -129,9 +129,16 @@ fn a_slab_lit_from_one_side_is_w_thick() {
         triangles: &s.triangles,
         irradiance: &irr,
     };
+    // The pass's bounding radius (1.01 × the box's half diagonal) decides a point light's map:
+    // six 90° faces within 1.5 radii, one face fitted to the sphere (half-angle θ, sin θ = R/D)
+    // beyond, the directional map beyond 10⁴ radii.
+    let radius = 1.01 * DVec3::new(1.0, 1.0, w / 2.0).length();
     for light in [
         Light::Directional(DVec3::Z),
+        Light::Point(DVec3::new(0.0, 0.0, 2.0)),
         Light::Point(DVec3::new(0.0, 0.0, 3.0)),
+        Light::Point(DVec3::new(0.0, 0.0, 300.0)),
+        Light::Point(DVec3::new(0.0, 0.0, 1e5)),
     ] {
         p.prepare(
             &gpu.device,
@@ -145,11 +152,14 @@ fn a_slab_lit_from_one_side_is_w_thick() {
         .unwrap();
         let (first, second) = p.read_light_layers(&gpu.device, &gpu.queue).unwrap();
         let n = 128usize;
-        // The face looking at the slab: slot 0 for the directional map, −Z (slot 5) for the point.
-        let slot = if matches!(light, Light::Directional(_)) {
-            0
-        } else {
-            5
+        // The face looking at the slab (slot 0, or −Z: slot 5, of the six faces), and
+        // 1 / tan of its half-angle (∞: parallel rays).
+        let (slot, scale) = match light {
+            Light::Point(p) if p.length() <= 1.5 * radius => (5, 1.0),
+            Light::Point(p) if p.length() <= 1e4 * radius => {
+                (0, (p.length_squared() - radius * radius).sqrt() / radius)
+            }
+            _ => (0, f64::INFINITY),
         };
         let mut checked = 0;
         for row in 0..n {
@@ -167,11 +177,8 @@ fn a_slab_lit_from_one_side_is_w_thick() {
                     continue;
                 }
                 let d = f64::from(second[i] - first[i]);
-                let exact = match light {
-                    Light::Directional(_) => w,
-                    // Along the texel's oblique ray from the point light the chord is w / cos.
-                    Light::Point(_) => w * (1.0 + u * u + v * v).sqrt(),
-                };
+                // Along the texel's oblique ray from the point light the chord is w / cos.
+                let exact = w * (1.0 + (u * u + v * v) / (scale * scale)).sqrt();
                 assert!(
                     (d - exact).abs() < 3e-3,
                     "{light:?} texel ({row}, {col}): d = {d}, exact {exact}"
@@ -188,7 +195,7 @@ fn the_frame_equals_eq_12_in_f64_pixel_by_pixel() {
     if gpu_context::testing::gpu_or_skip().is_none() {
         return;
     }
-    let (worst, count) = slab_frame_against_cpu(DVec3::ZERO, 1.0, false);
+    let (worst, count) = slab_frame_against_cpu(DVec3::ZERO, 1.0, None);
     eprintln!("{count} pixels, worst relative error {worst:.2e}");
     assert!(count > 300, "{count} pixels");
     assert!(worst < 2e-3, "worst relative error {worst}");
@@ -199,11 +206,19 @@ fn a_point_light_frame_equals_eq_12_in_f64() {
     if gpu_context::testing::gpu_or_skip().is_none() {
         return;
     }
-    // Only the faces of the six-face map the slab reaches are drawn (one here).
-    let (worst, count) = slab_frame_against_cpu(DVec3::ZERO, 1.0, true);
-    eprintln!("{count} pixels, worst relative error {worst:.2e}");
-    assert!(count > 300, "{count} pixels");
-    // A point light's distance field curves (as 1/r) across the map, so the Gaussian (σ = 2
-    // texels) and the bilinear look-up bias d by ~0.2 %, which A(d) ∝ d⁻³ triples.
-    assert!(worst < 2e-2, "worst relative error {worst}");
+    // The slab's bounding radius is 0.0716: a light 0.09 away (1.3 radii) draws the faces of
+    // the six-face map the slab reaches (one here); 0.5 and 50 (7 and 700 radii) one face fitted
+    // to the bounding sphere; 1e4 (1.4 × 10⁵ radii) the directional light's map. On six faces
+    // the slab spanned ~2 texels of 512 at 50 away, and the frame was wrong everywhere.
+    for distance in [0.09, 0.5, 50.0, 1e4] {
+        let (worst, count) = slab_frame_against_cpu(DVec3::ZERO, 1.0, Some(distance));
+        eprintln!("light {distance}: {count} pixels, worst relative error {worst:.2e}");
+        assert!(count > 300, "light {distance}: {count} pixels");
+        // A point light's distance field curves (as 1/r) across the map, so the Gaussian
+        // (σ = 2 texels) and the bilinear look-up bias d by ~0.2 %, which A(d) ∝ d⁻³ triples.
+        assert!(
+            worst < 2e-2,
+            "light {distance}: worst relative error {worst}"
+        );
+    }
 }

@@ -3,7 +3,9 @@
 struct Params {
     // xyz: the box's half extents (the "blindness" scale); w: faces of the light map (1 or 6).
     half_extent: vec4<f32>,
-    // xyz: point light (centred) or unit direction towards a directional light; w: 1 point, 0 directional.
+    // xyz: point light (centred) or unit direction towards a directional light; w: 0
+    // directional, 1 point (six 90° faces around it), 2 point (one face fitted to the bounding
+    // sphere, the light standing back from the object).
     light: vec4<f32>,
     // xyz: the eye, centred.
     eye: vec4<f32>,
@@ -18,7 +20,8 @@ struct Params {
     // Window factors h0, h1, h2 (SH bands); w: the attenuation's clamp distance (mm).
     window: vec4<f32>,
     // Per light-map face: forward, right, up; the w of entry 3i + 1 is the face instance i
-    // draws.
+    // draws; the w of a point light's forward is 1 / tan of the face's half-angle (1 for the
+    // six 90° faces).
     light_faces: array<vec4<f32>, 18>,
 };
 

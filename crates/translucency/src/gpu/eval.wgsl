@@ -47,17 +47,20 @@ fn light_lookup(x: vec3<f32>) -> vec4<f32> {
     if params.light.w > 0.5 {
         let d = x - params.light.xyz;
         let a = abs(d);
-        if a.x >= a.y && a.x >= a.z {
+        // One fitted face (light.w = 2), or the six faces' dominant axis.
+        if params.light.w > 1.5 {
+            face = 0u;
+        } else if a.x >= a.y && a.x >= a.z {
             face = select(1u, 0u, d.x > 0.0);
         } else if a.y >= a.z {
             face = select(3u, 2u, d.y > 0.0);
         } else {
             face = select(5u, 4u, d.z > 0.0);
         }
-        let f = params.light_faces[3u * face].xyz;
-        let w = dot(d, f);
-        uv = vec2<f32>(dot(d, params.light_faces[3u * face + 1u].xyz), dot(d, params.light_faces[3u * face + 2u].xyz)) / w;
-        texel_world = 2.0 * length(d) / size;
+        let f = params.light_faces[3u * face];
+        let w = dot(d, f.xyz);
+        uv = f.w * vec2<f32>(dot(d, params.light_faces[3u * face + 1u].xyz), dot(d, params.light_faces[3u * face + 2u].xyz)) / w;
+        texel_world = 2.0 * length(d) / (f.w * size);
     } else {
         let r = params.maps.z;
         uv = vec2<f32>(dot(x, params.light_faces[1].xyz), dot(x, params.light_faces[2].xyz)) / r;

@@ -12,8 +12,14 @@
 //! 2. **SH projection** (TR 143): a two-level reduction in compute, then eq. 10's three 4×4
 //!    matrices (window applied) — they stay on the GPU;
 //! 3. **light distance map** (TR 131): the linear distance along the light's ray to the nearest
-//!    surface (six faces around a point light — so a light inside the box works — or one
-//!    orthographic face for a directional light), `light_map_size`² per face (512² default);
+//!    surface, `light_map_size`² per face (512² default): for a point light within 1.5
+//!    bounding radii, the six 90° faces around it that the box reaches (so a light inside the
+//!    box works); farther out, one perspective face fitted to the bounding sphere (a 90° face
+//!    spans 2D at distance D, so an object of radius R covered size · R / D texels — 3.4 of
+//!    512 at 150 R, where the bunny's whole body read as thin and glowed); beyond 10⁴ radii,
+//!    where f32 distances from the
+//!    light no longer resolve the object, the directional map from its direction; for a
+//!    directional light, one orthographic face;
 //! 4. **one peeled layer** (TR 155): the nearest surface farther than the first by ε;
 //! 5. **separable Gaussian** on the first layer (9 taps, σ = 2 texels, empty texels left out);
 //!

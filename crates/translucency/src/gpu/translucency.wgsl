@@ -89,7 +89,8 @@ fn vs_light(v: MeshIn, @builtin(instance_index) instance: u32) -> LightOut {
         let w = dot(d, f);
         let near = params.misc.z;
         let far = params.misc.w;
-        clip = vec4<f32>(dot(d, r), dot(d, u), far / (far - near) * (w - near), w);
+        let s = params.light_faces[3u * face].w;
+        clip = vec4<f32>(s * dot(d, r), s * dot(d, u), far / (far - near) * (w - near), w);
     } else {
         let radius = params.maps.z;
         let z = (light_distance(v.centred) + radius) / (2.0 * radius);

@@ -195,8 +195,8 @@ mod gpu_frame {
 
     /// Render `shape` in black with translucency added; compare every interior pixel of the slab's
     /// far face (z = −w/2, facing the camera) with eq. 12 evaluated in f64 with the GPU's own E_lm.
-    /// `point`: a point light 0.5 × scale behind the slab instead of a directional one.
-    pub fn slab_frame_against_cpu(offset: DVec3, scale: f64, point: bool) -> (f64, usize) {
+    /// `point`: a point light this many × scale behind the slab instead of a directional one.
+    pub fn slab_frame_against_cpu(offset: DVec3, scale: f64, point: Option<f64>) -> (f64, usize) {
         let params = PipelineParams {
             window: Window::Gaussian { width: 5.0 },
             ..Default::default()
@@ -213,10 +213,9 @@ mod gpu_frame {
             .with_scale(1000.0 / scale)
             .unwrap();
         let light_dir = DVec3::new(0.2, 0.1, 1.0).normalize();
-        let light = if point {
-            Light::Point(offset + light_dir * 0.5 * scale)
-        } else {
-            Light::Directional(light_dir)
+        let light = match point {
+            Some(distance) => Light::Point(offset + light_dir * distance * scale),
+            None => Light::Directional(light_dir),
         };
         let eye = DVec3::new(0.03, -0.02, -0.3) * scale + offset;
         let size = 64;
