@@ -5,7 +5,8 @@
 //! tangent plane are 0 in M anyway), from the vertex pushed [`CpuParams::offset_relative`] ×
 //! the scene's bounding-box diagonal along its normal, to infinity, with a Möller–Trumbore
 //! triangle test in f32 on coordinates centred on the scene (so a 1e5 offset costs no
-//! precision). Receiver rows are visited in Morton (Z) order of their positions, in chunks of
+//! precision) and scaled by the power of two that brings its diagonal into (8, 16] (so a
+//! scene 10⁻²⁰ or 10¹⁵ across keeps f32's range, with the answers of scale 1 bit for bit). Receiver rows are visited in Morton (Z) order of their positions, in chunks of
 //! 64 spatial neighbours per rayon task. Three traversals, all exact ([`CpuMethod`]):
 //!
 //! * [`CpuMethod::Packets`]: the rays of one chunk towards one direction l_j are parallel and
@@ -134,7 +135,7 @@ use crate::fan::{FanTracer, Packed, PreparedDirections, RayFan, fan_groups};
 use crate::matrix::WORD_BITS;
 use crate::progress::Ticker;
 use crate::refit::scene_triangles;
-use crate::scene::Prepared;
+use crate::scene::{Prepared, power_of_two, scaled_max_t};
 
 mod packets;
 
@@ -357,7 +358,8 @@ impl EdgeTriangle {
 ///   rays' offset from the surface ([`DEFAULT_OFFSET_RELATIVE`]);
 /// * the debug check holds at any scale.
 ///
-/// The fans' own traversal has no such clamp.
+/// The fans' and packets' traversals have no such clamp, but scale their scenes alike, for
+/// f32's range ([`Prepared::tracer_scale`]).
 pub(crate) struct CpuTracer {
     bvh: CwBvh,
     triangles: Vec<EdgeTriangle>,
@@ -365,29 +367,11 @@ pub(crate) struct CpuTracer {
     scale: f32,
 }
 
-/// 2^`e` as an f32, exactly (`e` clamped to the normal range).
-fn power_of_two(e: i32) -> f32 {
-    f32::from_bits(((e.clamp(-126, 127) + 127) as u32) << 23)
-}
-
-/// The power of two that brings a scene of diagonal `diagonal` to a diagonal in (8, 16] (1
-/// for an empty or degenerate scene).
-fn tracer_scale(diagonal: f32) -> f32 {
-    if diagonal > 0.0 && diagonal.is_finite() {
-        power_of_two(4 - diagonal.log2().ceil() as i32)
-    } else {
-        1.0
-    }
-}
-
 impl CpuTracer {
     /// Builds the BVH over all scene triangles (degenerate ones included: they never hit).
     pub(crate) fn new(prepared: &Prepared) -> Self {
-        let scale = tracer_scale(prepared.diagonal);
-        let mut tris = scene_triangles(prepared);
-        for t in &mut tris {
-            (t.v0, t.v1, t.v2) = (t.v0 * scale, t.v1 * scale, t.v2 * scale);
-        }
+        let scale = prepared.tracer_scale();
+        let tris = scene_triangles(&prepared.scaled(scale));
         if tris.is_empty() {
             return Self {
                 bvh: CwBvh::default(),
@@ -431,11 +415,7 @@ impl CpuTracer {
         }
         let e = largest.log2().ceil() as i32;
         let t_scale = self.scale * power_of_two(e);
-        let max_t = if max_t.is_finite() {
-            (max_t * t_scale).min(f32::MAX)
-        } else {
-            max_t
-        };
+        let max_t = scaled_max_t(max_t, t_scale);
         (origin * self.scale, direction * power_of_two(-e), max_t)
     }
 

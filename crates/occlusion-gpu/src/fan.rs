@@ -93,7 +93,7 @@ use obvhs::bvh2::node::Bvh2Node;
 use crate::cpu::EDGE_TOLERANCE;
 use crate::refit::LeafOrder;
 use crate::refit::padded_bvh2;
-use crate::scene::Prepared;
+use crate::scene::{Prepared, scaled_max_t};
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
@@ -440,11 +440,18 @@ pub(crate) struct FanTracer {
     /// ([`lanes_alone`]): on wherever the [`Quad`]s could be built (always, with leaves of at
     /// most eight triangles), off in the test that shows it answers as the lane groups do.
     single: bool,
+    /// The power of two the tree, its triangles and every ray's origin and `max_t` are
+    /// multiplied by ([`Prepared::tracer_scale`]): the common-origin test's triple products
+    /// are coordinates cubed, which left f32's range for a mesh 10¹⁵ across and fell into
+    /// its subnormals for one 10⁻¹² across (the bunny so scaled lost up to 0.88 of a_i).
+    scale: f32,
 }
 
 impl FanTracer {
     /// `quality`: obvhs's build settings (a static scene affords the slowest, best tree).
     pub(crate) fn new(prepared: &Prepared, quality: BvhBuildParams) -> Self {
+        let scale = prepared.tracer_scale();
+        let prepared = &*prepared.scaled(scale);
         let (nodes, tris, leaves) = padded_bvh2(prepared, quality, FAN_LEAF_SIZE);
         let triangles = tris
             .iter()
@@ -459,6 +466,7 @@ impl FanTracer {
             leaves,
             wide: has_avx2(),
             single: true,
+            scale,
         };
         tracer.pack(prepared.diagonal);
         tracer
@@ -517,6 +525,8 @@ impl FanTracer {
 
     /// Refits to `prepared`'s positions (same topology); the new SAH cost over the build's.
     pub(crate) fn refit(&mut self, prepared: &Prepared) -> Option<f32> {
+        let scale = prepared.tracer_scale();
+        let prepared = &*prepared.scaled(scale);
         let cost = crate::refit::refit_tree(
             &mut self.nodes,
             &self.leaves,
@@ -525,11 +535,20 @@ impl FanTracer {
             FanTriangle,
         )?;
         self.pack(prepared.diagonal);
+        self.scale = scale;
         Some(cost)
+    }
+
+    /// `origin` and `max_t` in the tree's coordinates ([`FanTracer::scale`]; a finite `max_t`
+    /// stays finite).
+    #[inline(always)]
+    fn local(&self, origin: Vec3A, max_t: f32) -> (Vec3A, f32) {
+        (origin * self.scale, scaled_max_t(max_t, self.scale))
     }
 
     /// The lanes of `mask` whose rays `origin + t·d`, 0 < t < `max_t`, meet no triangle.
     pub(crate) fn unoccluded(&self, origin: Vec3A, fan: &RayFan, mask: u64, max_t: f32) -> u64 {
+        let (origin, max_t) = self.local(origin, max_t);
         STACKS.with_borrow_mut(|stacks| {
             #[cfg(target_arch = "x86_64")]
             if self.wide {

@@ -7,6 +7,7 @@
 //! rotates the look-up; a relative motion or a deformation changes the scene and M must be
 //! recomputed.
 
+use std::borrow::Cow;
 use std::ops::Range;
 
 use glam::{DMat3, DMat4, DVec3, Mat4, Vec3};
@@ -306,6 +307,63 @@ impl Prepared {
             triangles,
             receivers,
         })
+    }
+}
+
+impl Prepared {
+    /// The power of two that brings this scene's diagonal into (8, 16] (1 for a scene without
+    /// extent): the factor the `cpu` backend's tracers multiply their coordinates by, so that
+    /// neither their triple products (coordinates cubed) nor their boxes' areas leave f32's
+    /// normal range, whatever the scene's units (a mesh 10⁻²⁰ or 10¹⁵ across). A power of two
+    /// commutes with f32 rounding, so every decision is the one in the scene's own units
+    /// wherever those are representable.
+    pub(crate) fn tracer_scale(&self) -> f32 {
+        let diagonal = self.diagonal;
+        if diagonal > 0.0 && diagonal.is_finite() {
+            power_of_two(4 - diagonal.log2().ceil() as i32)
+        } else {
+            1.0
+        }
+    }
+
+    /// This scene with its centred coordinates multiplied by `scale` (positions, receivers'
+    /// positions, diagonal, radius; the centre and the normals unchanged); borrowed when
+    /// `scale` is 1.
+    pub(crate) fn scaled(&self, scale: f32) -> Cow<'_, Self> {
+        if scale == 1.0 {
+            return Cow::Borrowed(self);
+        }
+        Cow::Owned(Self {
+            center: self.center,
+            diagonal: self.diagonal * scale,
+            radius: self.radius * scale,
+            positions: self.positions.iter().map(|p| *p * scale).collect(),
+            triangles: self.triangles.clone(),
+            receivers: self
+                .receivers
+                .iter()
+                .map(|r| Receiver {
+                    position: r.position * scale,
+                    normal: r.normal,
+                })
+                .collect(),
+        })
+    }
+}
+
+/// 2^`e` as an f32, exactly (`e` clamped to the normal range).
+pub(crate) fn power_of_two(e: i32) -> f32 {
+    f32::from_bits(((e.clamp(-126, 127) + 127) as u32) << 23)
+}
+
+/// A ray's `max_t` multiplied by `scale`: a finite one stays finite (a bound past f32's range
+/// still bounds nothing nearer), an infinite one stays infinite.
+#[inline(always)]
+pub(crate) fn scaled_max_t(max_t: f32, scale: f32) -> f32 {
+    if max_t.is_finite() {
+        (max_t * scale).min(f32::MAX)
+    } else {
+        max_t
     }
 }
 

@@ -1,12 +1,15 @@
 //! Named adversarial cases (DESIGN.md "Hard cases stay numerically stable"), among them near
-//! occluders at any scene scale and direction length (`RayCaster`'s single rays).
+//! occluders at any scene scale and direction length (`RayCaster`'s single rays) and scenes
+//! 10⁻²⁴ to 10¹⁶ across (every `cpu` traversal).
 
 mod common;
 
 use common::*;
 use glam::{DVec3, Mat4, Vec3};
 use lightsphere::Lightsphere;
-use occlusion_gpu::{RayCaster, Scene, SceneObject, VisibilityEngine, VisibilityParams};
+use occlusion_gpu::{
+    CpuMethod, CpuParams, RayCaster, Scene, SceneObject, VisibilityEngine, VisibilityParams,
+};
 
 fn cpu_ambient(scene: &Scene, level: u32) -> Vec<f32> {
     VisibilityEngine::cpu(VisibilityParams::default())
@@ -263,6 +266,54 @@ fn offsets_and_scales_do_not_change_results() {
             mean < 2e-3 && share < 0.01,
             "{placement}: mean {mean}, share {share}"
         );
+    }
+}
+
+/// The sphere over the plane scaled by 2⁻⁸⁰ (10⁻²⁴ across) to 2⁵⁵ (10¹⁶ across) gives M bit for
+/// bit as at scale 1, with every traversal, to infinity and within a `max_distance` scaled
+/// alike. A power of two scales the f32 coordinates exactly, so only a test that leaves f32's
+/// normal range can tell: the fans' common-origin test multiplies three coordinates, which
+/// overflowed for the bunny 10¹⁵ across and fell into the subnormals 10⁻¹² across (a_i off by
+/// up to 0.88, 1.0 at 10⁻²⁰), and the packets' boxes and edges likewise, before every tracer
+/// worked at its own power-of-two scale.
+#[test]
+fn extreme_scene_scales_give_the_same_matrix() {
+    let sphere = Lightsphere::new(2).unwrap();
+    let matrix = |scale: f32, method: CpuMethod, max_distance: Option<f32>| {
+        let mut scene = Scene::new();
+        for object in sphere_over_plane().objects() {
+            let placed = object.world_from_object;
+            let to = Mat4::from_scale(Vec3::splat(scale)) * placed;
+            scene.push(object.clone().with_transform(to)).unwrap();
+        }
+        let mut cpu = CpuParams::default().with_method(method);
+        if let Some(d) = max_distance {
+            cpu = cpu.with_max_distance(d * scale);
+        }
+        VisibilityEngine::cpu(VisibilityParams::default().with_cpu(cpu))
+            .compute(&scene, &sphere)
+            .unwrap()
+    };
+    for method in [CpuMethod::Packets, CpuMethod::Fans, CpuMethod::SingleRays] {
+        for max_distance in [None, Some(0.45)] {
+            let reference = matrix(1.0, method, max_distance);
+            let open = reference.visible_count();
+            assert!(open > 0 && open < reference.rows() * sphere.len());
+            for e in [-80, -60, -40, -20, 20, 40, 55] {
+                let scale = 2f32.powi(e);
+                let scaled = matrix(scale, method, max_distance);
+                let differ = reference
+                    .bits()
+                    .iter()
+                    .zip(scaled.bits())
+                    .map(|(a, b)| (a ^ b).count_ones())
+                    .sum::<u32>();
+                assert_eq!(
+                    differ, 0,
+                    "{method:?}, max_distance {max_distance:?}, scale 2^{e}: {differ} bits differ"
+                );
+            }
+        }
     }
 }
 

@@ -9,7 +9,7 @@ use obvhs::BvhBuildParams;
 use super::{ColumnsCall, EdgeTriangle, in_chunks, ray_origin};
 use crate::matrix::WORD_BITS;
 use crate::refit::{LeafOrder, padded_bvh2};
-use crate::scene::Prepared;
+use crate::scene::{Prepared, scaled_max_t};
 
 /// `obvhs`'s build settings for the packets' tree (calls of under
 /// [`FAN_MIN_COLUMNS`](super::FAN_MIN_COLUMNS) columns, where the build is most of the time):
@@ -25,10 +25,16 @@ pub(super) struct PacketTracer {
     nodes: Vec<obvhs::bvh2::node::Bvh2Node>,
     triangles: Vec<EdgeTriangle>,
     leaves: LeafOrder,
+    /// The power of two the tree, its triangles and every ray's origin and `max_t` are
+    /// multiplied by ([`Prepared::tracer_scale`]: box areas and Möller–Trumbore's products
+    /// stay in f32's normal range at any scene scale).
+    scale: f32,
 }
 
 impl PacketTracer {
     pub(super) fn new(prepared: &Prepared) -> Self {
+        let scale = prepared.tracer_scale();
+        let prepared = &*prepared.scaled(scale);
         let (nodes, tris, leaves) = padded_bvh2(prepared, packet_build(), PACKET_LEAF_SIZE);
         let triangles = tris
             .iter()
@@ -38,18 +44,22 @@ impl PacketTracer {
             nodes,
             triangles,
             leaves,
+            scale,
         }
     }
 
     /// Refits to `prepared`'s positions (same topology); the new SAH cost over the build's.
     pub(super) fn refit(&mut self, prepared: &Prepared) -> Option<f32> {
-        crate::refit::refit_tree(
+        let scale = prepared.tracer_scale();
+        let ratio = crate::refit::refit_tree(
             &mut self.nodes,
             &self.leaves,
             &mut self.triangles,
-            prepared,
+            &prepared.scaled(scale),
             |t| EdgeTriangle::new(t.map(Vec3::from)),
-        )
+        )?;
+        self.scale = scale;
+        Some(ratio)
     }
 
     /// The rays of `mask` (bit r: ray from `origins[r]` towards `direction`) that meet no
@@ -160,10 +170,11 @@ pub(super) fn packet_columns(tracer: &PacketTracer, dirs: &[Vec3A], call: Column
         let mut normals = [Vec3A::ZERO; PACKET];
         for (r, &row) in rows.iter().enumerate() {
             if let Some((o, n)) = ray_origin(prepared, row as usize, span.offset) {
-                origins[r] = o;
+                origins[r] = o * tracer.scale;
                 normals[r] = n;
             }
         }
+        let max_t = scaled_max_t(span.max_t, tracer.scale);
         let mut rays = 0u64;
         for j in columns.clone() {
             let direction = dirs[j];
@@ -174,7 +185,7 @@ pub(super) fn packet_columns(tracer: &PacketTracer, dirs: &[Vec3A], call: Column
                 }
             }
             rays += u64::from(mask.count_ones());
-            let mut visible = tracer.unoccluded(&origins, direction, mask, span.max_t);
+            let mut visible = tracer.unoccluded(&origins, direction, mask, max_t);
             while visible != 0 {
                 let r = visible.trailing_zeros() as usize;
                 visible &= visible - 1;

@@ -65,10 +65,11 @@ fn eight_lanes_answer_as_four_lanes() {
         for fan in &fans {
             let mask = fan.full_mask();
             for max_t in [f32::INFINITY, 5.0] {
+                let (o, t) = tracer.local(origin, max_t);
                 let four = if max_t == f32::INFINITY {
-                    tracer.traverse::<false>(origin, fan, mask, max_t, &mut stacks)
+                    tracer.traverse::<false>(o, fan, mask, t, &mut stacks)
                 } else {
-                    tracer.traverse::<true>(origin, fan, mask, max_t, &mut stacks)
+                    tracer.traverse::<true>(o, fan, mask, t, &mut stacks)
                 };
                 let eight = tracer.unoccluded(origin, fan, mask, max_t);
                 lanes += mask.count_ones();
