@@ -252,7 +252,9 @@ impl MaskRenderer {
             lo = lo.min(v[1]);
             hi = hi.max(v[1]);
         }
-        let margin = (hi - lo).max(1e-6) * 0.01;
+        // Relative to the grid, not absolute: a floor of 1e-6 units flattened a caster 10⁻²¹
+        // across into one depth value.
+        let margin = (hi - lo).max(1e-6 * hx.max(hz)) * 0.01;
         let (top, bottom) = (hi + margin, lo - margin);
         // x → columns, z → rows (row 0 at z0, the top of the image), height → depth 0 at `top`.
         let clip_from_world = Mat4::from_cols_array(&[

@@ -58,7 +58,9 @@ impl GroundGrid {
     /// grid needs no square extent; cells follow the extent's aspect).
     ///
     /// # Errors
-    /// As [`GroundGrid::new`]; an empty or flat (zero x or z extent) mesh gets a unit margin.
+    /// As [`GroundGrid::new`]. A flat mesh (zero x or z extent) gets a half-width of half its
+    /// largest extent along that axis (a vertical sheet's shadow leaves its plane); an empty
+    /// mesh, or a single point, a unit square.
     pub fn around(positions: &[Vec3], y: f64, n: usize) -> Result<Self, ShadowError> {
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         for p in positions {
@@ -69,7 +71,12 @@ impl GroundGrid {
             (lo, hi) = (DVec3::ZERO, DVec3::ZERO);
         }
         let centre = (lo + hi) / 2.0;
-        let half = ((hi - lo) * 1.5).max(DVec3::splat(0.5));
+        // Relative, not absolute: a floor of 0.5 units once widened the grid of every mesh
+        // under a third of a unit across (the Stanford bunny, in metres, 2.2×) and hid a
+        // mesh 10⁻²⁰ across in one cell.
+        let largest = (hi - lo).max_element();
+        let floor = if largest > 0.0 { 0.5 * largest } else { 0.5 };
+        let half = ((hi - lo) * 1.5).max(DVec3::splat(floor));
         Self::new(
             y,
             [
@@ -112,7 +119,9 @@ pub fn ground_extrusion(positions: &[Vec3], grid: &GroundGrid) -> f64 {
         lo = lo.min(p.as_dvec3());
         hi = hi.max(p.as_dvec3());
     }
-    2.0 * (hi - lo).length().max(1e-9)
+    // The grid's extent is validated non-empty, so the box has a length (a floor of 1e-9 units
+    // here made the volumes of a caster 10⁻²¹ across 10¹² times too long).
+    2.0 * (hi - lo).length()
 }
 
 /// The exact mask of `grid` (row-major, N × N, 1 = the cell centre's segment to the light

@@ -87,7 +87,9 @@ fn fs_lit(in: LitOut, @builtin(front_facing) front_facing: bool) -> @location(0)
     if shadow_light.position.w > 0.5 {
         let d = shadow_light.position.xyz - in.world;
         l = normalize(d);
-        irradiance = irradiance / max(dot(d, d), 1e-12);
+        // Only a light on the surface itself is guarded: an absolute 1e-12 flattened the
+        // falloff of every light nearer than 1e-6 units.
+        irradiance = irradiance / max(dot(d, d), 1e-37);
     }
     var visibility = 1.0;
     if shadow_light.intensity.w > 0.5 {

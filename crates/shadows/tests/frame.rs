@@ -2,7 +2,7 @@
 //! a sphere over a ground quad seen from outside every volume; two lights accumulating, each
 //! masked by its own stencil count, over an ambient term that stays in shadow — z-fail and
 //! z-pass both equal the rays here. The eye inside a volume and the near plane cutting one, where
-//! z-pass fails, are in `hard_cases.rs`.
+//! z-pass fails, are in `hard_cases.rs`. The same frame at scales 2⁻²⁴ and 2²⁰.
 
 #![cfg(feature = "gpu")]
 
@@ -11,7 +11,7 @@ mod common;
 use common::frame::*;
 use glam::{DVec3, Vec3};
 use render::Camera;
-use shadows::Light;
+use shadows::{Counting, Light};
 
 #[test]
 fn seen_from_outside_every_volume_the_stencil_equals_rays() {
@@ -47,6 +47,46 @@ fn two_lights_accumulate_and_the_ambient_term_stays_in_shadow() {
         (Light::Point(DVec3::new(-1.5, 5.0, 0.5)), 30.0),
     ];
     check("two lights", camera, &lights, 0.05, true);
+}
+
+/// The two lights' frame of a scene scaled by 2⁻²⁴ (the sphere 1.2 × 10⁻⁷ across) and by 2²⁰,
+/// camera and point light with it and the point light's intensity by the square of the scale
+/// (the same radiance), is the frame at scale 1 (relative 10⁻³, every pixel). The lit shader
+/// once guarded the point light's 1/d² with an absolute floor of 10⁻¹² on d², which flattened
+/// the falloff of every light nearer than 10⁻⁶ units.
+#[test]
+fn a_scene_at_any_scale_renders_the_same_frame() {
+    let frame = |e: i32| {
+        let s = 2f32.powi(e);
+        let camera = Camera::look_at(
+            Vec3::new(0.5, 7.0, 4.0) * s,
+            Vec3::ZERO,
+            Vec3::Y,
+            60.0,
+            SIZE,
+            SIZE,
+        );
+        let lights = [
+            (sun(), 2.0),
+            (
+                Light::Point(DVec3::new(-1.5, 5.0, 0.5) * f64::from(s)),
+                30.0 * s * s,
+            ),
+        ];
+        render(&scenery_at(s), &camera, &lights, 0.05, Counting::ZFail)
+    };
+    let Some(reference) = frame(0) else { return };
+    let lit = reference.iter().filter(|p| p[0] > 0.1).count();
+    assert!(lit > (SIZE * SIZE / 4) as usize, "{lit} lit pixels");
+    for e in [-24, 20] {
+        let image = frame(e).unwrap();
+        let differ = reference
+            .iter()
+            .zip(&image)
+            .filter(|(a, b)| (a[0] - b[0]).abs() > 1e-3 * a[0].max(1e-2))
+            .count();
+        assert_eq!(differ, 0, "scale 2^{e}: {differ} pixels differ");
+    }
 }
 
 /// The whole frame against [`shadows::exact_view_mask`]: a faceted sphere that casts on

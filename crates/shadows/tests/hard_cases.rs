@@ -2,7 +2,7 @@
 //! plane crossing a volume; open cloth (border edges); a light in a face's plane (n·l = 0);
 //! degenerate and duplicated triangles; the light inside the caster's bounding box; coplanar
 //! caster and receiver; a caster offset by 1e5; a loose piece under a Hausdorff budget; a
-//! distant point light (1e4 to 1e15 away). Masks are compared with exact rays away from
+//! distant point light (1e4 to 1e15 away); a caster at any scale (10⁻²¹ to 10¹⁵ across). Masks are compared with exact rays away from
 //! shadow boundaries (cells whose 3 × 3 neighbourhood is uniform); the GPU halves skip without
 //! an adapter and fail under `CI`.
 
@@ -247,6 +247,45 @@ fn a_distant_point_light() {
             near * 10 <= boundary.max(10),
             "{name}: {near} of {boundary}"
         );
+    }
+}
+
+#[test]
+fn a_caster_at_any_scale() {
+    // The cube, its point light and the default grid around it, all scaled by a power of two
+    // (exact in f32 and f64): the same mask bit for bit. The default grid once had an absolute
+    // floor of 0.5 units, so a cube 10⁻²¹ across fell inside one cell (0 % shadowed) and
+    // every mesh under a third of a unit got a wider grid than its ×3 box; the exact rays'
+    // fans, before their power-of-two scaling, lost f32's range at 10¹² and 10⁻¹².
+    let (positions, triangles) = cube(Vec3::new(0.2, 1.0, -0.1), 0.5);
+    let grid_at = |scale: f64| {
+        let scaled: Vec<Vec3> = positions.iter().map(|p| *p * scale as f32).collect();
+        let grid = GroundGrid::around(&scaled, 0.0, 64).unwrap();
+        (scaled, grid)
+    };
+    let (_, unit_grid) = grid_at(1.0);
+    // The ×3 box of a unit cube: 3 units wide, centred on it.
+    for (got, want) in unit_grid.extent.iter().zip([-1.3, -1.6, 1.7, 1.4]) {
+        assert!((got - want).abs() < 1e-6, "{:?}", unit_grid.extent);
+    }
+    let light = DVec3::new(0.7, 3.0, 0.4);
+    let reference =
+        exact_ground_mask(&positions, &triangles, &Light::Point(light), &unit_grid).unwrap();
+    let share = shadowed_share(&reference);
+    assert!(share > 0.05 && share < 0.6, "the cube's shadow: {share}");
+    for e in [-70, -40, 30, 50] {
+        let scale = 2f64.powi(e);
+        let (scaled, grid) = grid_at(scale);
+        let name = format!("scale 2^{e}");
+        let mask = agree_everywhere(
+            &name,
+            &scaled,
+            &triangles,
+            &Light::Point(light * scale),
+            Sides::Two,
+            &grid,
+        );
+        assert_eq!(mask, reference, "{name}");
     }
 }
 

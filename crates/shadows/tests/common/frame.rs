@@ -20,8 +20,17 @@ pub struct Scenery {
 }
 
 pub fn scenery() -> Scenery {
-    let caster = sphere(Vec3::new(0.0, 2.0, 0.0), 1.0, 3);
-    let g = GROUND;
+    scenery_at(1.0)
+}
+
+/// [`scenery`] with every coordinate multiplied by `scale`.
+pub fn scenery_at(scale: f32) -> Scenery {
+    let (points, triangles) = sphere(Vec3::new(0.0, 2.0, 0.0), 1.0, 3);
+    let caster = (
+        points.iter().map(|p| *p * scale).collect::<Vec<_>>(),
+        triangles,
+    );
+    let g = GROUND * scale;
     let ground = (
         vec![
             Vec3::new(-g, 0.0, -g),
