@@ -30,7 +30,7 @@ pub fn resolve(desc: &CameraDesc, centre: Vec3, radius: f32) -> Camera {
             desc.width,
             desc.height,
             centre,
-            radius.max(1e-6),
+            render::usable_radius(radius),
         ),
     }
 }

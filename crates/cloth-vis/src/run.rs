@@ -422,8 +422,12 @@ pub(crate) fn ground_object(
     let (centre, radius) = bounding_sphere(&points).unwrap_or((Vec3::ZERO, 1.0));
     let height = points.iter().map(|p| p.y).fold(f32::INFINITY, f32::min);
     let height = if height.is_finite() { height } else { 0.0 };
-    let (positions, triangles, uvs) =
-        render::ground::ground_grid(centre, height, desc.size * radius.max(1e-3), desc.cells);
+    let (positions, triangles, uvs) = render::ground::ground_grid(
+        centre,
+        height,
+        desc.size * render::usable_radius(radius),
+        desc.cells,
+    );
     let normals = vec![Vec3::Y; positions.len()];
     WorldObject {
         name: GROUND_NAME.to_owned(),

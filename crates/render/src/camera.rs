@@ -128,7 +128,7 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Self {
-        let radius = radius.max(1e-6);
+        let radius = usable_radius(radius);
         let fov = fov_y_deg.to_radians();
         let aspect = width as f32 / height.max(1) as f32;
         let half = (fov * 0.5).min((aspect * (fov * 0.5).tan()).atan());
@@ -151,7 +151,8 @@ impl Camera {
         radius: f32,
     ) -> Self {
         let distance = (eye - centre).length();
-        let near = (distance - 1.5 * radius).max(distance * 1e-3).max(1e-4);
+        // Relative to the scene alone (an eye inside the sphere still gets a near plane).
+        let near = (distance - 1.5 * radius).max(distance.max(radius) * 1e-3);
         let far = (distance + 1.5 * radius).max(near * 2.0);
         Self {
             eye,
@@ -249,6 +250,17 @@ impl Camera {
             }
         };
         Ok(clip_from_view * self.view_from_world())
+    }
+}
+
+/// `radius` where it is positive and finite, else 1: the radius to frame, zoom and size
+/// things by. Relative sizes only: an absolute floor (10⁻⁶ here, 10⁻⁴ on the near plane) once
+/// clipped away every mesh under 10⁻⁴ across, and a mesh 10⁻²⁰ across renders as one 1 across.
+pub fn usable_radius(radius: f32) -> f32 {
+    if radius > 0.0 && radius.is_finite() {
+        radius
+    } else {
+        1.0
     }
 }
 

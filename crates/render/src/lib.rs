@@ -75,7 +75,7 @@ mod tonemap;
 
 #[cfg(feature = "gpu")]
 pub use backdrop::{BACKDROP_SHADER, Backdrop, BackdropPass, MAX_BACKDROP_WIDTH};
-pub use camera::{Camera, CameraError, DepthConvention, bounding_sphere};
+pub use camera::{Camera, CameraError, DepthConvention, bounding_sphere, usable_radius};
 #[cfg(feature = "gpu")]
 pub use error::RenderError;
 #[cfg(feature = "gpu")]

@@ -1,5 +1,5 @@
 //! The hard cases the frame defends: a sun 10⁴× the sky, non-finite radiance, degenerate and
-//! empty meshes, huge coordinate offsets, a scene of zero size.
+//! empty meshes, huge coordinate offsets, a scene of zero size, scenes 10⁻⁸ to 10¹² across.
 
 mod common;
 
@@ -127,4 +127,34 @@ fn huge_coordinate_offsets_render_the_same_coverage() {
     // silhouette moves by under a pixel.
     let (a, b) = (counts[0] as f32, counts[1] as f32);
     assert!(a > 500.0 && (a - b).abs() / a < 0.05, "{counts:?}");
+}
+
+#[test]
+fn a_scene_at_any_scale_renders_the_same_coverage() {
+    // A triangle 2·2^e across, framed by `Camera::framing`: the camera's sizes are all
+    // relative, so the same pixels are covered at every scale (powers of two scale f32
+    // exactly). A near plane floored at 10⁻⁴ units once clipped every scene under 10⁻⁴
+    // across (the Stanford bunny scaled by 10⁻⁴ rendered empty).
+    let Some(gpu) = gpu_or_skip() else { return };
+    let mut renderer = Renderer::new(&gpu.device, FrameFormat::for_context(&gpu));
+    let mut counts = Vec::new();
+    for e in [0, -27, -14, 20, 40] {
+        let s = 2f32.powi(e);
+        let p = [
+            Vec3::new(-1.0, -1.0, 0.3) * s,
+            Vec3::new(1.0, -1.0, -0.2) * s,
+            Vec3::new(0.0, 1.0, 0.0) * s,
+        ];
+        let c = [Vec3::ONE; 3];
+        common::one_mesh(&mut renderer, &gpu, &p, &[[0, 1, 2]], &c, &c).unwrap();
+        let (centre, radius) = render::bounding_sphere(&p).unwrap();
+        let camera = Camera::framing(centre, radius, centre, Vec3::Z, Vec3::Y, 35.0, 64, 64);
+        camera.validate().unwrap();
+        counts.push((e, covered(&mut renderer, &gpu, &camera)));
+    }
+    let reference = counts[0].1;
+    assert!(reference > 500, "{counts:?}");
+    for &(e, count) in &counts {
+        assert_eq!(count, reference, "scale 2^{e}: {counts:?}");
+    }
 }

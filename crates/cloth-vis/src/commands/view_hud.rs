@@ -154,7 +154,7 @@ impl Hud<'_> {
                 if let Some(p) = settings.point_light.as_mut() {
                     ui.horizontal(|ui| {
                         ui.label("point light");
-                        let step = 0.01 * self.live.bounds().1.max(1e-3);
+                        let step = 0.01 * render::usable_radius(self.live.bounds().1);
                         for v in [&mut p.x, &mut p.y, &mut p.z] {
                             ui.add(egui::DragValue::new(v).speed(step));
                         }

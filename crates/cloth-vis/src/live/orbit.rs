@@ -70,7 +70,7 @@ impl Orbit {
     /// thousandth of the objects' radius.
     pub fn zoom(&mut self, factor: f32) {
         let offset = self.eye - self.target;
-        let min = 1e-3 * self.bounds.1.max(1e-6);
+        let min = 1e-3 * render::usable_radius(self.bounds.1);
         let length = (offset.length() * factor).max(min);
         self.eye = self.target + offset.normalize_or(Vec3::Z) * length;
     }
@@ -91,7 +91,7 @@ impl Orbit {
             width,
             height,
             centre,
-            radius.max(1e-6),
+            render::usable_radius(radius),
         )
     }
 }
