@@ -94,3 +94,39 @@ fn a_refitted_tree_gives_every_frame_the_m_of_a_fresh_one() {
         assert_eq!(refitting.last_bvh().update, BvhUpdate::Built);
     }
 }
+
+/// A scene that grows threefold between calls crosses the power of two each tracer scales its
+/// coordinates by: the refitted tree takes the new scale with the new boxes (the same M as a
+/// fresh tree), and the refit is kept, as the SAH ratio does not depend on the scale.
+#[test]
+fn a_refit_across_a_change_of_scale_gives_the_m_of_a_fresh_tree() {
+    let (frames, triangles, ball) = drape_frames();
+    let sphere = Lightsphere::new(2).unwrap();
+    let last = frames.last().unwrap();
+    for method in [CpuMethod::Packets, CpuMethod::Fans] {
+        let cpu = CpuParams::default()
+            .with_method(method)
+            .with_refit_timed(false);
+        let mut refitting = VisibilityEngine::cpu(VisibilityParams::default().with_cpu(cpu));
+        let mut rebuilding =
+            VisibilityEngine::cpu(VisibilityParams::default().with_cpu(cpu.with_refit(false)));
+        for grow in [1.0f32, 3.0, 0.2] {
+            let scaled = |mesh: &[Vec3]| mesh.iter().map(|p| *p * grow).collect::<Vec<_>>();
+            let scene = scene(
+                &scaled(last),
+                &triangles,
+                &(scaled(&ball.0), ball.1.clone()),
+            );
+            let a = refitting.compute(&scene, &sphere).unwrap();
+            let b = rebuilding.compute(&scene, &sphere).unwrap();
+            assert_eq!(a.bits(), b.bits(), "{method:?} grown {grow}");
+            if grow != 1.0 {
+                assert!(
+                    matches!(refitting.last_bvh().update, BvhUpdate::Refitted { .. }),
+                    "{method:?} grown {grow}: {:?}",
+                    refitting.last_bvh().update
+                );
+            }
+        }
+    }
+}
