@@ -150,7 +150,8 @@ impl App {
         event_loop.exit();
     }
 
-    /// The scripted run's line on stdout: frames, file and the final camera.
+    /// The scripted run's line on stdout: frames, file and the final camera (each coordinate
+    /// in full: six decimals printed a mesh 10⁻⁶ across as zeros).
     fn summary(&self) -> Option<String> {
         self.request.frames?;
         let (w, h) = self.size();
@@ -165,8 +166,8 @@ impl App {
             .map(|(e, on)| format!("{}={}", e.name(), if *on { "on" } else { "off" }))
             .collect();
         Some(format!(
-            "view: {} frames presented ({w}×{h}); {}; level {}; {}{}; eye [{:.6}, {:.6}, {:.6}] \
-             target [{:.6}, {:.6}, {:.6}]{}",
+            "view: {} frames presented ({w}×{h}); {}; level {}; {}{}; eye [{}, {}, {}] \
+             target [{}, {}, {}]{}",
             self.presented,
             self.stats,
             self.live.settings().level,
