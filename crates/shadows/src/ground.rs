@@ -55,12 +55,13 @@ impl GroundGrid {
     }
 
     /// The default extent: the mesh's x/z bounding box scaled ×3 about its centre (a square
-    /// grid needs no square extent; cells follow the extent's aspect).
+    /// grid needs no square extent; cells follow the extent's aspect). Along x or z, a mesh
+    /// under a third of its largest extent wide (a vertical sheet: zero) gets a half-width of
+    /// half that largest extent instead (the sheet's shadow leaves its plane); an empty mesh,
+    /// or a single point, a unit square.
     ///
     /// # Errors
-    /// As [`GroundGrid::new`]. A flat mesh (zero x or z extent) gets a half-width of half its
-    /// largest extent along that axis (a vertical sheet's shadow leaves its plane); an empty
-    /// mesh, or a single point, a unit square.
+    /// As [`GroundGrid::new`].
     pub fn around(positions: &[Vec3], y: f64, n: usize) -> Result<Self, ShadowError> {
         let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
         for p in positions {
