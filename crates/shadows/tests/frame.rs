@@ -32,20 +32,24 @@ fn seen_from_outside_every_volume_the_stencil_equals_rays() {
     );
 }
 
-#[test]
-fn two_lights_accumulate_and_the_ambient_term_stays_in_shadow() {
+/// The camera and lights of the two-lights frame for a scene scaled by `s` (the point light's
+/// intensity by s², so that its radiance is the same).
+fn two_lights_at(s: f32) -> (Camera, [(Light, f32); 2]) {
     let camera = Camera::look_at(
-        Vec3::new(0.5, 7.0, 4.0),
+        Vec3::new(0.5, 7.0, 4.0) * s,
         Vec3::ZERO,
         Vec3::Y,
         60.0,
         SIZE,
         SIZE,
     );
-    let lights = [
-        (sun(), 2.0),
-        (Light::Point(DVec3::new(-1.5, 5.0, 0.5)), 30.0),
-    ];
+    let point = Light::Point(DVec3::new(-1.5, 5.0, 0.5) * f64::from(s));
+    (camera, [(sun(), 2.0), (point, 30.0 * s * s)])
+}
+
+#[test]
+fn two_lights_accumulate_and_the_ambient_term_stays_in_shadow() {
+    let (camera, lights) = two_lights_at(1.0);
     check("two lights", camera, &lights, 0.05, true);
 }
 
@@ -58,21 +62,7 @@ fn two_lights_accumulate_and_the_ambient_term_stays_in_shadow() {
 fn a_scene_at_any_scale_renders_the_same_frame() {
     let frame = |e: i32| {
         let s = 2f32.powi(e);
-        let camera = Camera::look_at(
-            Vec3::new(0.5, 7.0, 4.0) * s,
-            Vec3::ZERO,
-            Vec3::Y,
-            60.0,
-            SIZE,
-            SIZE,
-        );
-        let lights = [
-            (sun(), 2.0),
-            (
-                Light::Point(DVec3::new(-1.5, 5.0, 0.5) * f64::from(s)),
-                30.0 * s * s,
-            ),
-        ];
+        let (camera, lights) = two_lights_at(s);
         render(&scenery_at(s), &camera, &lights, 0.05, Counting::ZFail)
     };
     let Some(reference) = frame(0) else { return };
