@@ -10,6 +10,11 @@ use crate::{Light, ShadowError};
 /// Largest grid side: 8192² cells of f32 are 256 MiB.
 pub const MAX_GRID: usize = 8192;
 
+/// How far [`GroundGrid::around_shadow`] reaches from the mesh's centre, in the mesh's largest
+/// extents: a sun 3.6° above the horizon casts the shadow of a mesh as tall as it is wide 16
+/// widths long.
+pub const MAX_SHADOW_REACH: f64 = 16.0;
+
 /// The receiver plane and its sampling: row j ↔ z_j = z0 + (j + ½)(z1 − z0)/N ascending,
 /// column i ↔ x_i = x0 + (i + ½)(x1 − x0)/N ascending.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,6 +93,71 @@ impl GroundGrid {
             ],
             n,
         )
+    }
+
+    /// [`GroundGrid::around`] grown to hold the mesh's whole shadow under `light`: the part of
+    /// the mesh's bounding box above the plane, projected from the light onto it (a mesh's
+    /// shadow lies in its box's, the hull of the corners' projections), with a margin of 5 % of
+    /// that footprint — reaching at most [`MAX_SHADOW_REACH`] × the mesh's largest extent from
+    /// its centre (a light level with the mesh's top casts a shadow without end). Where nothing
+    /// can cast (the mesh or the light at or below the plane), the box of [`GroundGrid::around`].
+    ///
+    /// # Errors
+    /// As [`GroundGrid::new`]; [`ShadowError::Light`] for an invalid light.
+    pub fn around_shadow(
+        positions: &[Vec3],
+        light: &Light,
+        y: f64,
+        n: usize,
+    ) -> Result<Self, ShadowError> {
+        let base = Self::around(positions, y, n)?;
+        let light = light.validated()?;
+        let (mut lo, hi) = positions
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+            });
+        let largest = (hi - lo).max_element();
+        if positions.is_empty() || hi.y <= y || largest.is_nan() || largest <= 0.0 {
+            return Ok(base);
+        }
+        lo.y = lo.y.max(y);
+        let centre = (lo + hi) / 2.0;
+        let reach = MAX_SHADOW_REACH * largest;
+        let (mut f_lo, mut f_hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for k in 0..8 {
+            let c = DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            let onto = match light {
+                Light::Directional(d) if d.y > 0.0 => c - d * ((c.y - y) / d.y),
+                Light::Point(l) if l.y > c.y => l + (c - l) * ((l.y - y) / (l.y - c.y)),
+                // A corner level with or above a point light: its shadow runs to the horizon,
+                // away from the light (everywhere, for a corner straight above it).
+                Light::Point(l) if l.y > y => {
+                    let away = DVec3::new(c.x - l.x, 0.0, c.z - l.z).normalize_or_zero();
+                    if away == DVec3::ZERO {
+                        let all = DVec3::new(reach, 0.0, reach);
+                        (f_lo, f_hi) = (f_lo.min(centre - all), f_hi.max(centre + all));
+                    }
+                    c + away * (2.0 * reach)
+                }
+                _ => return Ok(base),
+            };
+            (f_lo, f_hi) = (f_lo.min(onto), f_hi.max(onto));
+        }
+        let margin = 0.05 * (f_hi - f_lo).max_element();
+        let [x0, z0, x1, z1] = base.extent;
+        let clamp = |v: f64, c: f64| v.clamp(c - reach, c + reach);
+        let extent = [
+            clamp((f_lo.x - margin).min(x0), centre.x),
+            clamp((f_lo.z - margin).min(z0), centre.z),
+            clamp((f_hi.x + margin).max(x1), centre.x),
+            clamp((f_hi.z + margin).max(z1), centre.z),
+        ];
+        Self::new(y, extent, n)
     }
 
     /// World position of cell (i = column, j = row).

@@ -2,7 +2,8 @@
 //! plane crossing a volume; open cloth (border edges); a light in a face's plane (n·l = 0);
 //! degenerate and duplicated triangles; the light inside the caster's bounding box; coplanar
 //! caster and receiver; a caster offset by 1e5; a loose piece under a Hausdorff budget; a
-//! distant point light (1e4 to 1e15 away); a caster at any scale (10⁻²¹ to 10¹⁵ across). Masks are compared with exact rays away from
+//! distant point light (1e4 to 1e15 away); a caster at any scale (10⁻²¹ to 10¹⁵ across); a
+//! low light's long shadow on the default grid. Masks are compared with exact rays away from
 //! shadow boundaries (cells whose 3 × 3 neighbourhood is uniform); the GPU halves skip without
 //! an adapter and fail under `CI`.
 
@@ -287,6 +288,72 @@ fn a_caster_at_any_scale() {
         );
         assert_eq!(mask, reference, "{name}");
     }
+}
+
+/// Shadowed cells on the grid's outermost rows and columns.
+fn on_the_border(mask: &[f32], n: usize) -> usize {
+    (0..n * n)
+        .filter(|&k| {
+            mask[k] > 0.0 && (k / n == 0 || k / n == n - 1 || k % n == 0 || k % n == n - 1)
+        })
+        .count()
+}
+
+#[test]
+fn a_low_lights_long_shadow() {
+    // The default grid holds the whole shadow: a sun 12° above the horizon, a point light
+    // just above the cube, one above its middle (the shadow all around). The ×3 box alone
+    // cut the first two (the bunny's ears under a lamp 30 cm above it ran off the mask).
+    // Level with the cube's top the shadow has no end, and the grid stops at 16 widths.
+    let (positions, triangles) = cube(Vec3::new(0.3, 1.0, -0.2), 0.5);
+    let n = 128;
+    let low_sun = DVec3::new(1.0, 12f64.to_radians().tan(), 0.4);
+    let lights = [
+        ("a low sun", Light::Directional(low_sun)),
+        ("a lamp just above", Light::Point(DVec3::new(1.5, 1.8, 0.0))),
+        (
+            "a lamp over the middle",
+            Light::Point(DVec3::new(0.35, 1.7, -0.2)),
+        ),
+    ];
+    for (name, light) in lights {
+        let grid = GroundGrid::around_shadow(&positions, &light, 0.0, n).unwrap();
+        let mask = exact_ground_mask(&positions, &triangles, &light, &grid).unwrap();
+        let share = shadowed_share(&mask);
+        assert!(share > 0.01, "{name}: {share}");
+        assert_eq!(
+            on_the_border(&mask, n),
+            0,
+            "{name}: the shadow leaves the grid"
+        );
+        // The ×3 box alone saw less than 90 % of the shadow's area.
+        let area = |g: &GroundGrid, mask: &[f32]| {
+            let [x0, z0, x1, z1] = g.extent;
+            shadowed_share(mask) * (x1 - x0) * (z1 - z0)
+        };
+        let boxed = GroundGrid::around(&positions, 0.0, n).unwrap();
+        let cut = exact_ground_mask(&positions, &triangles, &light, &boxed).unwrap();
+        let (whole, seen) = (area(&grid, &mask), area(&boxed, &cut));
+        if name != "a lamp over the middle" {
+            assert!(
+                seen < 0.9 * whole,
+                "{name}: the ×3 box saw {seen} of {whole}"
+            );
+        }
+    }
+    let level = Light::Point(DVec3::new(2.0, 1.5, 0.0));
+    let grid = GroundGrid::around_shadow(&positions, &level, 0.0, n).unwrap();
+    let [x0, _, x1, _] = grid.extent;
+    // Away from the light at x = 2: to x = 0.3 − 16, and no further than the ×3 box towards it.
+    assert!(
+        (x0 - (0.3 - 16.0)).abs() < 1e-6 && x1 < 2.0,
+        "{:?}",
+        grid.extent
+    );
+    // Nothing casts below the plane: the ×3 box.
+    let below = Light::Point(DVec3::new(0.0, -1.0, 0.0));
+    let grid = GroundGrid::around_shadow(&positions, &below, 0.0, n).unwrap();
+    assert_eq!(grid, GroundGrid::around(&positions, 0.0, n).unwrap());
 }
 
 #[test]

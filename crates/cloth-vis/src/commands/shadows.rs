@@ -3,7 +3,8 @@
 //!
 //! The mesh (optionally a simplified caster, `--lod`) casts onto the plane y = Y under a point
 //! or directional light. The output is an f32 `[N, N]` `.npy` over the extent (default: the
-//! mesh's x/z bounding box scaled ×3 about its centre): row j ↔ z_j = Z0 + (j + ½)(Z1 − Z0)/N
+//! mesh's x/z bounding box scaled ×3 about its centre, grown to hold the whole shadow —
+//! [`shadows::GroundGrid::around_shadow`]): row j ↔ z_j = Z0 + (j + ½)(Z1 − Z0)/N
 //! ascending, column i ↔ x_i likewise; 1 = the ground point's segment to the light is blocked,
 //! 0 = lit. Computed through the z-fail stencil pipeline seen by an orthographic camera from
 //! above, or by exact rays through a BVH with `--cpu`. `--render` draws the mesh over the
@@ -58,8 +59,9 @@ pub struct ShadowsArgs {
     /// asset authored Z-up (Blender, CAD, the Berkeley garments).
     #[arg(long, value_enum, default_value = "y", allow_hyphen_values = true)]
     up_axis: UpAxis,
-    /// The sampled extent X0,Z0,X1,Z1 (default: the mesh's x/z box scaled ×3 about its centre;
-    /// with --up-axis, the stood-up frame's x/z: for z, the input's x and −y).
+    /// The sampled extent X0,Z0,X1,Z1 (default: the mesh's x/z box scaled ×3 about its centre,
+    /// grown to hold the whole shadow up to 16 × the mesh's size from its centre; with
+    /// --up-axis, the stood-up frame's x/z: for z, the input's x and −y).
     #[arg(long, value_name = "X0,Z0,X1,Z1", value_parser = parse_extent, allow_hyphen_values = true)]
     ground_extent: Option<[f64; 4]>,
     /// Cells per side of the mask.
@@ -237,7 +239,7 @@ impl ShadowsArgs {
         }
         let grid = match self.ground_extent {
             Some(extent) => GroundGrid::new(self.ground, extent, self.grid),
-            None => GroundGrid::around(&mesh.positions, self.ground, self.grid),
+            None => GroundGrid::around_shadow(&mesh.positions, &light, self.ground, self.grid),
         }
         .map_err(|e| invalid(&self.input, e.to_string()))?;
         let (caster, lod_note, level) = match lod {
