@@ -312,3 +312,39 @@ fn bad_flags_are_refused_before_any_output() {
     ]);
     assert!(!ok && stderr.contains(".npy"), "{stderr}");
 }
+
+/// Without `--ground-extent` the mask holds the whole shadow of the square under a lamp just
+/// above its height (the ×3 box alone ends 1.25 from the square's centre; this shadow runs
+/// past 7): no shadowed cell on the mask's border, the square's footprint shadowed.
+#[test]
+fn the_default_extent_holds_a_low_lamps_whole_shadow() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = square(dir.path());
+    let out = dir.path().join("low.npy");
+    let (ok, stdout, stderr) = run(&[
+        "shadows",
+        text(&input),
+        "--light-pos",
+        "1.5,1.2,0",
+        "--ground",
+        "0",
+        "--cpu",
+        "--grid",
+        "64",
+        "--out",
+        text(&out),
+    ]);
+    assert!(ok, "{stderr}");
+    let mask = meshio::read_npy_f32(&out).unwrap().data;
+    let n = 64;
+    let border = (0..n * n)
+        .filter(|&k| {
+            mask[k] > 0.0 && (k / n == 0 || k / n == n - 1 || k % n == 0 || k % n == n - 1)
+        })
+        .count();
+    let share = mask.iter().sum::<f32>() / mask.len() as f32;
+    assert!(
+        border == 0 && share > 0.02,
+        "{border} border cells, {share}: {stdout}"
+    );
+}
