@@ -227,22 +227,25 @@ impl ShadowVolumeStage {
             }
             triangles += volume.stats().triangles();
         }
-        let receiving: Vec<&WorldObject> = objects
+        let receiving: Vec<(usize, &WorldObject)> = objects
             .iter()
-            .filter(|o| self.receivers.is_empty() || self.receivers.contains(&o.name))
+            .enumerate()
+            .filter(|(_, o)| self.receivers.is_empty() || self.receivers.contains(&o.name))
             .collect();
         let albedo: Vec<Vec<Vec3>> = receiving
             .iter()
-            .map(|o| vec![o.albedo; o.positions.len()])
+            .map(|(_, o)| vec![o.albedo; o.positions.len()])
             .collect();
         let receivers: Vec<Receiver> = receiving
             .iter()
             .zip(&albedo)
-            .map(|(o, albedo)| Receiver {
+            .map(|((index, o), albedo)| Receiver {
                 positions: &o.positions,
                 normals: &o.normals,
                 albedo,
                 triangles: &o.triangles,
+                // Eq. 5.6's boundary belongs on the casters' own surfaces only.
+                casts: self.casters.iter().any(|c| c.object == *index),
             })
             .collect();
         self.effect

@@ -10,7 +10,7 @@
 //!    and where the near plane cuts one (z-pass is wrong in both);
 //! 3. the receivers are drawn again with depth `Equal` and stencil `Equal 0`, adding the
 //!    light's direct term ρ/π · E · max(n·l, 0) · tex(u) (eq. 5.6's boundary texture when the
-//!    light asks for it) — lit ⇔ stencil = 0, so the ambient and environment terms stay and
+//!    light asks for it, on receivers that cast) — lit ⇔ stencil = 0, so the ambient and environment terms stay and
 //!    only the light's own term is masked.
 //!
 //! Volumes are extruded to infinity (w = 0), so the frame must use
@@ -41,9 +41,14 @@ pub struct Receiver<'a> {
     pub albedo: &'a [Vec3],
     /// Triangles.
     pub triangles: &'a [[u32; 3]],
+    /// Whether this surface also casts (its own volume's silhouette edges run along it): only
+    /// such a receiver takes eq. 5.6's smooth boundary. One that casts nothing — a ground
+    /// plane — has no zig-zag to hide, and the term would only black out wherever light grazes
+    /// it at under α (a ground under a sun 12° up rendered without any shadow at α = 15°).
+    pub casts: bool,
 }
 
-/// The smooth boundary of eq. 5.6 on a light's receivers.
+/// The smooth boundary of eq. 5.6 on a light's casting receivers ([`Receiver::casts`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SmoothBoundary {
     /// Offset α in degrees (the thesis's 15°).
@@ -89,6 +94,7 @@ struct GpuReceiver {
     index_count: u32,
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
+    casts: bool,
 }
 
 #[derive(Debug)]
@@ -323,6 +329,7 @@ impl StencilShadows {
                     .map_err(|_| ShadowError::Mesh(format!("receiver {r}: too many triangles")))?,
                 positions: m.positions.to_vec(),
                 normals: m.normals.to_vec(),
+                casts: m.casts,
             });
         }
         // Per-light u buffers follow the receivers.
@@ -413,11 +420,13 @@ impl StencilShadows {
             gpu.volume_vertices = u32::try_from(vertices.len()).unwrap_or(u32::MAX);
             for (r, buffer) in self.receivers.iter().zip(&gpu.u) {
                 let mut pairs: Vec<[f32; 2]> = vec![[1.0, 1.0]; r.positions.len()];
-                // Eq. 5.6 per vertex for the front side and the back side (normal negated).
+                // Eq. 5.6 per vertex for the front side and the back side (normal negated), on
+                // a surface that casts.
                 if let Some(b) = l.boundary {
                     crate::boundary::check_alpha(b.alpha_deg)?;
                     let alpha = b.alpha_deg.to_radians();
-                    for ((pair, p), n) in pairs.iter_mut().zip(&r.positions).zip(&r.normals) {
+                    let vertices = r.positions.iter().zip(&r.normals);
+                    for (pair, (p, n)) in pairs.iter_mut().zip(vertices).filter(|_| r.casts) {
                         let (n, l) = (n.as_dvec3(), light.to_light(p.as_dvec3()));
                         *pair = [
                             boundary_u(n, l, alpha, b.mode) as f32,

@@ -79,6 +79,36 @@ fn a_scene_at_any_scale_renders_the_same_frame() {
     }
 }
 
+/// Eq. 5.6's boundary (α = 15°) is the casters' own: a ground that casts nothing, under a sun
+/// 10° up, is lit and shadowed exactly as without it (every pixel against the rays; the sphere
+/// lowered to 0.2 above the ground, so that its long shadow starts on it). Applied to the
+/// ground, the term blacked it out wherever light grazed it at under α — no shadow left to
+/// see.
+#[test]
+fn a_low_sun_lights_a_ground_that_casts_nothing_despite_the_boundary() {
+    use shadows::BoundaryMode;
+    use shadows::frame::SmoothBoundary;
+    let (camera, _) = two_lights_at(1.0);
+    let low = DVec3::new(0.9, 10f64.to_radians().tan() * 0.9f64.hypot(0.3), 0.3).normalize();
+    let lights = [(Light::Directional(low), 6.0)];
+    let s = scenery_of(Vec3::new(0.0, 1.2, 0.0), 1.0);
+    let boundary = SmoothBoundary {
+        alpha_deg: 15.0,
+        mode: BoundaryMode::Cosine,
+    };
+    let Some(gpu) = render_with(&s, &camera, &lights, 0.05, Counting::ZFail, Some(boundary)) else {
+        return;
+    };
+    let exact = exact(&s, &camera, &lights, 0.05);
+    let (compared, _) = agree("low sun", &gpu, &exact);
+    let lit = exact.iter().flatten().filter(|&&e| e > 0.06).count();
+    let dark = exact.iter().flatten().filter(|&&e| e <= 0.06).count();
+    assert!(
+        lit > compared / 4 && dark > 20,
+        "{lit} lit, {dark} in shadow"
+    );
+}
+
 /// The whole frame against [`shadows::exact_view_mask`]: a faceted sphere that casts on
 /// itself and on the ground, both receivers (facet normals, so the light's term is dark
 /// exactly where the facet faces away, as the exact mask's own-surface test is).
@@ -137,11 +167,13 @@ fn the_frame_equals_the_exact_mask_of_its_view() {
     let receivers: Vec<Receiver> = meshes
         .iter()
         .zip(&albedo)
-        .map(|(m, a)| Receiver {
+        .zip([true, false])
+        .map(|((m, a), casts)| Receiver {
             positions: m.0,
             normals: &m.2,
             albedo: a,
             triangles: m.1,
+            casts,
         })
         .collect();
     effect.set_receivers(&gpu.device, &receivers).unwrap();

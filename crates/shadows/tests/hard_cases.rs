@@ -514,6 +514,7 @@ fn render_self_shadowed(
                 normals: &normals,
                 albedo: &albedo,
                 triangles,
+                casts: true,
             }],
         )
         .unwrap();

@@ -73,6 +73,7 @@ fn panel(
             normals: n,
             albedo: a,
             triangles: &o.triangles,
+            casts: o.caster.is_some(),
         })
         .collect();
     effect.set_receivers(&gpu.device, &receivers)?;

@@ -6,7 +6,7 @@ use super::sphere;
 use glam::{DVec3, Vec3, Vec4};
 use occlusion_gpu::{RayCaster, Scene};
 use render::{Background, Camera, DepthConvention, DrawMesh, FrameFormat, Renderer};
-use shadows::frame::{FrameLight, Receiver, StencilShadows};
+use shadows::frame::{FrameLight, Receiver, SmoothBoundary, StencilShadows};
 use shadows::volume::{CasterTopology, Extrusion, ShadowVolume, Sides, VolumeParams};
 use shadows::{BoundaryTexture, Counting, Light};
 
@@ -25,7 +25,13 @@ pub fn scenery() -> Scenery {
 
 /// [`scenery`] with every coordinate multiplied by `scale`.
 pub fn scenery_at(scale: f32) -> Scenery {
-    let (points, triangles) = sphere(Vec3::new(0.0, 2.0, 0.0), 1.0, 3);
+    scenery_of(Vec3::new(0.0, 2.0, 0.0), scale)
+}
+
+/// The sphere of radius 1 centred at `centre` over the ground, every coordinate multiplied by
+/// `scale`.
+pub fn scenery_of(centre: Vec3, scale: f32) -> Scenery {
+    let (points, triangles) = sphere(centre, 1.0, 3);
     let caster = (
         points.iter().map(|p| *p * scale).collect::<Vec<_>>(),
         triangles,
@@ -62,6 +68,18 @@ pub fn render(
     lights: &[(Light, f32)],
     ambient: f32,
     counting: Counting,
+) -> Option<Vec<[f32; 4]>> {
+    render_with(s, camera, lights, ambient, counting, None)
+}
+
+/// [`render`] with eq. 5.6's smooth boundary on every light (the ground casts nothing).
+pub fn render_with(
+    s: &Scenery,
+    camera: &Camera,
+    lights: &[(Light, f32)],
+    ambient: f32,
+    counting: Counting,
+    boundary: Option<SmoothBoundary>,
 ) -> Option<Vec<[f32; 4]>> {
     let gpu = gpu_context::testing::gpu_or_skip()?;
     let format =
@@ -107,6 +125,7 @@ pub fn render(
                 normals: &normals,
                 albedo: &albedo,
                 triangles: &s.ground.1,
+                casts: false,
             }],
         )
         .unwrap();
@@ -132,7 +151,7 @@ pub fn render(
             light: *light,
             intensity: Vec3::splat(*intensity),
             volume,
-            boundary: None,
+            boundary,
         })
         .collect();
     effect
