@@ -6,8 +6,9 @@
 //! the scene's bounding-box diagonal along its normal, to infinity, with a Möller–Trumbore
 //! triangle test in f32 on coordinates centred on the scene (so a 1e5 offset costs no
 //! precision) and scaled by the power of two that brings its diagonal into (8, 16] (so a
-//! scene 10⁻²⁰ or 10¹⁵ across keeps f32's range, with the answers of scale 1 bit for bit). Receiver rows are visited in Morton (Z) order of their positions, in chunks of
-//! 64 spatial neighbours per rayon task. Three traversals, all exact ([`CpuMethod`]):
+//! scene 10⁻²⁰ or 10¹⁵ across keeps f32's range, with the answers of scale 1 bit for bit).
+//! Receiver rows are visited in Morton (Z) order of their positions, in chunks of 64 spatial
+//! neighbours per rayon task. Three traversals, all exact ([`CpuMethod`]):
 //!
 //! * [`CpuMethod::Packets`]: the rays of one chunk towards one direction l_j are parallel and
 //!   start close together, so they walk a binary BVH together: a node is skipped outright when

@@ -253,9 +253,10 @@ impl Camera {
     }
 }
 
-/// `radius` where it is positive and finite, else 1: the radius to frame, zoom and size
-/// things by. Relative sizes only: an absolute floor (10⁻⁶ here, 10⁻⁴ on the near plane) once
-/// clipped away every mesh under 10⁻⁴ across, and a mesh 10⁻²⁰ across renders as one 1 across.
+/// `radius` where it is positive and finite, else 1 (a single point, or an empty scene): the
+/// radius to frame, zoom and size things by. Any positive radius is kept as it is — an
+/// absolute floor (10⁻⁶ here, 10⁻⁴ on the near plane) once clipped away every mesh under
+/// 10⁻⁴ across.
 pub fn usable_radius(radius: f32) -> f32 {
     if radius > 0.0 && radius.is_finite() {
         radius

@@ -10,8 +10,8 @@
 //!    and where the near plane cuts one (z-pass is wrong in both);
 //! 3. the receivers are drawn again with depth `Equal` and stencil `Equal 0`, adding the
 //!    light's direct term ρ/π · E · max(n·l, 0) · tex(u) (eq. 5.6's boundary texture when the
-//!    light asks for it, on receivers that cast) — lit ⇔ stencil = 0, so the ambient and environment terms stay and
-//!    only the light's own term is masked.
+//!    light asks for it, on receivers that cast) — lit ⇔ stencil = 0, so the ambient and
+//!    environment terms stay and only the light's own term is masked.
 //!
 //! Volumes are extruded to infinity (w = 0), so the frame must use
 //! [`render::DepthConvention::ReversedInfinite`]: points at infinity land on depth 0, in

@@ -118,7 +118,7 @@ impl GroundGrid {
                 (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
             });
         let largest = (hi - lo).max_element();
-        if positions.is_empty() || hi.y <= y || largest.is_nan() || largest <= 0.0 {
+        if positions.is_empty() || hi.y <= y || !largest.is_finite() || largest <= 0.0 {
             return Ok(base);
         }
         lo.y = lo.y.max(y);
