@@ -26,9 +26,9 @@ use glam::Vec3;
 use lightsphere::Lightsphere;
 use occlusion_gpu::{RayCaster, Scene, SceneObject, VisibilityEngine, VisibilityParams};
 
-struct Case {
-    name: String,
-    scene: Scene,
+pub(crate) struct Case {
+    pub(crate) name: String,
+    pub(crate) scene: Scene,
     level: u32,
 }
 
@@ -39,12 +39,12 @@ struct Ours {
     trace_ms: f64,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 
-fn mesh_case(name: &str, relative: &str, level: u32) -> anyhow::Result<Case> {
+pub(crate) fn mesh_case(name: &str, relative: &str, level: u32) -> anyhow::Result<Case> {
     let path = test_data::data_root().join(relative);
     let (mesh, _) = meshio::load_mesh(&path, &meshio::LoadOptions::default())
         .with_context(|| path.display().to_string())?;
@@ -56,7 +56,7 @@ fn mesh_case(name: &str, relative: &str, level: u32) -> anyhow::Result<Case> {
     })
 }
 
-fn drape_case(level: u32) -> anyhow::Result<Case> {
+pub(crate) fn drape_case(level: u32) -> anyhow::Result<Case> {
     let params = synth::ClothParams::default();
     let cloth = synth::simulate_cloth(&params)?;
     let frame = &cloth.frames[cloth.frames.len() / 2];

@@ -35,6 +35,9 @@
 //! - `cargo xtask bench visibility [--quick] [--threads 2]`: occlusion-gpu's `cpu` backend
 //!   beside Mitsuba 3 (Embree) and Open3D on the same rays, as ratios
 //!   (`target/repro/bench-visibility.md`; the peers in a virtual environment).
+//! - `cargo xtask bench visibility-gpu [--quick] [--runs 21] [--only bunny]`: occlusion-gpu's `depth` backend
+//!   on the adapter at hand, beside the exact `cpu` backend on the same machine: time, host
+//!   CPU and cells of M that differ (`target/repro/bench-visibility-gpu.md`).
 //! - `cargo xtask compare clustering [--quick]`: the clustering crate beside scikit-learn's
 //!   PCA and KMeans on the same data (numpy and scikit-learn in a virtual environment).
 //! - `cargo xtask compare translucency [--quick]`: seed 004's translucency model against
@@ -42,6 +45,7 @@
 //!   beside plain diffuse shading's; Mitsuba in a virtual environment).
 
 mod bench_visibility;
+mod bench_visibility_gpu;
 mod compare_clustering;
 mod compare_translucency;
 mod python;
@@ -100,6 +104,20 @@ enum Bench {
         /// Threads for every library.
         #[arg(long, default_value_t = 2)]
         threads: usize,
+    },
+    /// occlusion-gpu's `depth` backend on the adapter at hand beside the exact `cpu` backend:
+    /// time per frame, host CPU per frame, and what the depth maps cost in accuracy.
+    VisibilityGpu {
+        /// The bunny at k = 66 and 258, at 256² and 1024² (checks the run on a software
+        /// adapter).
+        #[arg(long)]
+        quick: bool,
+        /// Timed calls per case (after three warm-up calls).
+        #[arg(long, default_value_t = 21)]
+        runs: usize,
+        /// Only this mesh's rows.
+        #[arg(long, value_parser = ["bunny", "dragon", "igea", "drape"])]
+        only: Option<String>,
     },
 }
 
@@ -239,6 +257,9 @@ fn main() -> anyhow::Result<()> {
             let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
             bench_visibility::run(&root, &repro_dir()?, quick, threads)
         }
+        Command::Bench {
+            what: Bench::VisibilityGpu { quick, runs, only },
+        } => bench_visibility_gpu::run(&repro_dir()?, quick, runs, only.as_deref()),
         Command::Compare {
             what: Compare::Clustering { quick },
         } => {

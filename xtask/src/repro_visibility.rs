@@ -28,7 +28,7 @@ mod report;
 /// of the three runs is reported; longer ones are run once.
 pub(crate) const REPEAT_BELOW_MS: f64 = 1000.0;
 /// Vertices whose a_i differs by more than this count as "off".
-const OFF_THRESHOLD: f32 = 0.05;
+pub(crate) const OFF_THRESHOLD: f32 = 0.05;
 /// On a software adapter, `query` (one draw per vertex and direction) runs a level only when
 /// its predicted time — N·k × the time per draw measured at the previous level (at first the
 /// warm-up's) — is at most this many seconds.
@@ -97,17 +97,17 @@ struct CaseResult {
 
 /// |a − b| over the vertices where both are finite.
 #[derive(Clone, Copy, Default)]
-struct ErrorStats {
-    mean: f64,
-    max: f64,
+pub(crate) struct ErrorStats {
+    pub(crate) mean: f64,
+    pub(crate) max: f64,
     /// Fraction of compared vertices with |a − b| > [`OFF_THRESHOLD`].
-    off: f64,
+    pub(crate) off: f64,
     /// Compared vertices with a ≠ b.
     differ: usize,
     compared: usize,
 }
 
-fn error_stats(a: &[f32], b: &[f32]) -> ErrorStats {
+pub(crate) fn error_stats(a: &[f32], b: &[f32]) -> ErrorStats {
     let (mut sum, mut max, mut off, mut differ, mut compared) =
         (0.0f64, 0.0f64, 0usize, 0usize, 0usize);
     for (x, y) in a.iter().zip(b) {

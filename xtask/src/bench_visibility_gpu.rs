@@ -1,0 +1,269 @@
+//! `cargo xtask bench visibility-gpu [--quick] [--runs N] [--only MESH]`: occlusion-gpu's
+//! `depth` backend on the adapter at hand (issue #20's GPU target: the full bunny at k = 1026 in ≤ 5 ms,
+//! depth passes included), beside the exact `cpu` backend on the same machine.
+//!
+//! Per case: the median and the fastest of `--runs` calls of [`VisibilityEngine::ambient`]
+//! on one engine (pipelines built once; each call uploads the scene, renders every depth map,
+//! tests every vertex and reads a_i back, as a deforming frame pays), after three warm-up
+//! calls; the CPU time the calling thread spent per call (recording, submission, driver:
+//! when it is close to the wall time the host is the limit, not the GPU); and what the speed
+//! costs in accuracy: the share of M's cells that differ from the `cpu` backend's exact M,
+//! and max |Δa_i|. The `cpu` backend's time (BVH build + trace, all threads) is measured on
+//! the same machine for the ratio.
+//!
+//! Cases: the bunny at k = 6 … 1026 (depth maps of 1024²), the bunny at k = 1026 at 256² …
+//! 2048² and with batches of 16 and 256 layers, the dragon and igea at k = 258, a frame of
+//! the synthetic drape with its ball at k = 258 and 1026. `--quick` (for a software adapter):
+//! the bunny at k = 66 and 258, at 256² and 1024². Writes
+//! `target/repro/bench-visibility-gpu.md`. `--only MESH` keeps one mesh's rows.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::Context as _;
+use lightsphere::Lightsphere;
+use occlusion_gpu::{Backend, DepthParams, VisibilityEngine, VisibilityParams};
+
+use crate::bench_visibility::{Case, drape_case, median, mesh_case};
+use crate::repro_visibility::{ErrorStats, error_stats};
+
+/// Calls before the timed ones (shader compilation, first allocations).
+const WARM_UP_RUNS: usize = 3;
+
+/// One measured configuration of the `depth` backend.
+struct Setting {
+    case: usize,
+    resolution: u32,
+    /// Layers per batch (`DepthParams::max_array_bytes` / layer bytes); `None`: the default.
+    layers: Option<u64>,
+}
+
+/// The exact answer for one (mesh, level), computed once.
+struct Exact {
+    case: usize,
+    level: u32,
+    millis: f64,
+    matrix: occlusion_gpu::VisibilityMatrix,
+}
+
+/// CPU time the calling thread has used, in nanoseconds (`/proc/thread-self/schedstat`);
+/// `None` where the file does not exist.
+fn thread_cpu_ns() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    text.split_whitespace().next()?.parse().ok()
+}
+
+/// Share of the cells of `a` that differ from `b` (same shape).
+fn differing_cells(
+    a: &occlusion_gpu::VisibilityMatrix,
+    b: &occlusion_gpu::VisibilityMatrix,
+) -> f64 {
+    let differ: u64 = a
+        .bits()
+        .iter()
+        .zip(b.bits())
+        .map(|(x, y)| u64::from((x ^ y).count_ones()))
+        .sum();
+    differ as f64 / (a.rows() * a.directions_len()).max(1) as f64
+}
+
+fn exact<'a>(
+    cache: &'a mut Vec<Exact>,
+    cases: &[Case],
+    case: usize,
+    level: u32,
+) -> anyhow::Result<&'a Exact> {
+    if let Some(index) = cache
+        .iter()
+        .position(|e| e.case == case && e.level == level)
+    {
+        return Ok(&cache[index]);
+    }
+    let sphere = Lightsphere::new(level)?;
+    let mut times = Vec::new();
+    let mut matrix = None;
+    for _ in 0..3 {
+        let start = Instant::now();
+        let m = VisibilityEngine::cpu(VisibilityParams::default())
+            .compute(&cases[case].scene, &sphere)?;
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+        matrix = Some(m);
+    }
+    cache.push(Exact {
+        case,
+        level,
+        millis: median(times),
+        matrix: matrix.context("three runs")?,
+    });
+    cache.last().context("just pushed")
+}
+
+/// Runs the benchmark and writes the report under `repro`.
+pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow::Result<()> {
+    let runs = runs.max(1);
+    let ctx = gpu_context::GpuContext::new(&gpu_context::GpuOptions::default())
+        .context("the GPU benchmark needs an adapter")?;
+    let adapter = ctx.summary();
+    eprintln!("adapter: {adapter}");
+    if adapter.is_software && !quick {
+        eprintln!(
+            "warning: {} is a software rasteriser; its times prove nothing about a GPU \
+             (use --quick to check the benchmark runs)",
+            adapter.name
+        );
+    }
+    let max_layers = ctx.device.limits().max_texture_array_layers;
+    let mut cases = vec![mesh_case("bunny", "meshes/bun_zipper.ply", 0)?];
+    let mut settings: Vec<(Setting, u32)> = Vec::new();
+    if quick {
+        for level in [2, 3] {
+            for resolution in [256, 1024] {
+                let s = Setting {
+                    case: 0,
+                    resolution,
+                    layers: None,
+                };
+                settings.push((s, level));
+            }
+        }
+    } else {
+        for level in 0..=4 {
+            let s = Setting {
+                case: 0,
+                resolution: 1024,
+                layers: None,
+            };
+            settings.push((s, level));
+        }
+        for resolution in [256, 512, 2048] {
+            let s = Setting {
+                case: 0,
+                resolution,
+                layers: None,
+            };
+            settings.push((s, 4));
+        }
+        for layers in [16, 256] {
+            let s = Setting {
+                case: 0,
+                resolution: 1024,
+                layers: Some(layers),
+            };
+            settings.push((s, 4));
+        }
+        let wants = |mesh: &str| only.is_none_or(|only| only == mesh);
+        let mut extra: Vec<(Case, &[u32])> = Vec::new();
+        if wants("dragon") {
+            extra.push((mesh_case("dragon", "meshes/dragon_vrip_res2.ply", 0)?, &[3]));
+        }
+        if wants("igea") {
+            extra.push((mesh_case("igea", "meshes/igea.ply", 0)?, &[3]));
+        }
+        if wants("drape") {
+            extra.push((drape_case(0)?, &[3, 4]));
+        }
+        for (case, levels) in extra {
+            cases.push(case);
+            for &level in levels {
+                let s = Setting {
+                    case: cases.len() - 1,
+                    resolution: 1024,
+                    layers: None,
+                };
+                settings.push((s, level));
+            }
+        }
+    }
+    let mut table = String::new();
+    writeln!(
+        table,
+        "| mesh | N | k | depth map | maps per batch | median ms | fastest ms | host CPU \
+         ms | ms per direction | `cpu` ms (same machine) | `cpu` ÷ `depth` | cells ≠ exact \
+         | max \\|Δa\\| | vertices \\|Δa\\| > 0.05 |"
+    )?;
+    writeln!(
+        table,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    )?;
+    let mut cache = Vec::new();
+    for (setting, level) in &settings {
+        let case = &cases[setting.case];
+        let sphere = Lightsphere::new(*level)?;
+        let k = sphere.len();
+        let mesh = case.name.split('-').next().unwrap_or(&case.name);
+        if only.is_some_and(|only| mesh != only) {
+            continue;
+        }
+        let mut depth = DepthParams::default().with_resolution(setting.resolution);
+        let layer_bytes = u64::from(setting.resolution).pow(2) * 4;
+        if let Some(layers) = setting.layers {
+            depth.max_array_bytes = layers * layer_bytes;
+        }
+        // As occlusion-gpu batches: layers of one 2D array, within the byte budget and the
+        // device's layer limit.
+        let layers = (depth.max_array_bytes / layer_bytes)
+            .clamp(1, u64::from(max_layers))
+            .min(k as u64);
+        let params = VisibilityParams::default().with_depth(depth);
+        let mut engine =
+            VisibilityEngine::with_gpu(&ctx.device, &ctx.queue, Backend::Depth, params);
+        eprint!(
+            "{mesh} k = {k}, {}², {layers} maps per batch: ",
+            setting.resolution
+        );
+        for _ in 0..WARM_UP_RUNS {
+            engine.ambient(&case.scene, &sphere)?;
+        }
+        let (mut wall, mut host) = (Vec::new(), Vec::new());
+        for _ in 0..runs {
+            let cpu_before = thread_cpu_ns();
+            let start = Instant::now();
+            let ambient = engine.ambient(&case.scene, &sphere)?;
+            wall.push(start.elapsed().as_secs_f64() * 1e3);
+            if let (Some(a), Some(b)) = (cpu_before, thread_cpu_ns()) {
+                host.push(b.saturating_sub(a) as f64 * 1e-6);
+            }
+            std::hint::black_box(ambient);
+        }
+        let fastest = wall.iter().copied().fold(f64::INFINITY, f64::min);
+        let wall_median = median(wall);
+        let host_median = (!host.is_empty()).then(|| median(host));
+        let matrix = engine.compute(&case.scene, &sphere)?;
+        let exact = exact(&mut cache, &cases, setting.case, *level)?;
+        let cells = differing_cells(&matrix, &exact.matrix);
+        let ErrorStats { max, off, .. } = error_stats(&matrix.ambient(), &exact.matrix.ambient());
+        eprintln!("{wall_median:.2} ms (cpu {:.1} ms)", exact.millis);
+        let n = case.scene.receiver_count();
+        let resolution = setting.resolution;
+        let host = host_median.map_or("—".to_owned(), |h| format!("{h:.2}"));
+        let per_direction = wall_median / k as f64;
+        let ratio = exact.millis / wall_median;
+        let (cpu_ms, cells, off) = (exact.millis, cells * 100.0, off * 100.0);
+        writeln!(
+            table,
+            "| {mesh} | {n} | {k} | {resolution}² | {layers} | {wall_median:.2} | {fastest:.2} \
+             | {host} | {per_direction:.4} | {cpu_ms:.1} | {ratio:.2}× | {cells:.3} % | \
+             {max:.3} | {off:.2} % |"
+        )?;
+    }
+    let threads = std::thread::available_parallelism().map_or(1, usize::from);
+    let report = format!(
+        "# Visibility on the GPU: occlusion-gpu's `depth` backend\n\n\
+         Adapter: {adapter}. `cpu` (exact, BVH build + trace) on the same machine's {threads} \
+         threads. Each `depth` time is the median of {runs} calls of `ambient` after \
+         {WARM_UP_RUNS} warm-up calls on one engine: scene upload, every depth map, the \
+         vertex tests and the read-back of a_i. Host CPU: what the calling thread spent per \
+         call (recording and submitting the passes). Cells ≠ exact: the share of M's cells \
+         where the depth maps decide differently from the exact ray cast.\n\n{table}\n\
+         Written by `cargo xtask bench visibility-gpu{}{}`.\n",
+        if quick { " --quick" } else { "" },
+        only.map_or(String::new(), |m| format!(" --only {m}"))
+    );
+    print!("\n{report}");
+    let path = repro.join("bench-visibility-gpu.md");
+    atomic_out::write_bytes(&path, report.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
