@@ -420,12 +420,21 @@ pub(crate) struct SceneBuffers {
 
 impl SceneBuffers {
     /// Uploads the scene and allocates the outputs for `directions.len()` columns.
+    ///
+    /// The geometry goes up multiplied by [`Prepared::tracer_scale`], the power of two that
+    /// brings the diagonal into (8, 16] (as the `cpu` backend's tracers do): the shaders' f32
+    /// products then never underflow or overflow, so a scene 10⁻²⁴ or 10¹⁶ across gets the M
+    /// of the same scene in metres, bit for bit (a power of two commutes with f32 rounding).
+    /// Without it both GPU backends got a third of the cells of a sphere over a plane wrong at
+    /// 2⁻⁸⁰.
     pub(crate) fn new(
         device: &wgpu::Device,
         prepared: &Prepared,
         directions: &[Vec3],
         solid_angles: &[f64],
     ) -> Result<Self, OcclusionError> {
+        let scaled = prepared.scaled(prepared.tracer_scale());
+        let prepared = &*scaled;
         let k = directions.len();
         let rows = prepared.receivers.len();
         let words_per_row = k.div_ceil(WORD_BITS);
