@@ -1,21 +1,24 @@
-//! `cargo xtask bench visibility-gpu [--quick] [--runs N] [--only MESH]`: occlusion-gpu's
-//! `depth` backend on the adapter at hand (issue #20's GPU target: the full bunny at k = 1026 in ≤ 5 ms,
-//! depth passes included), beside the exact `cpu` backend on the same machine.
+//! `cargo xtask bench visibility-gpu [--quick] [--runs N] [--only MESH]`: occlusion-gpu's GPU
+//! backends on the adapter at hand — `depth` (issue #20's GPU target: the full bunny at
+//! k = 1026 in ≤ 5 ms, depth passes included) and the exact `rays` — beside the `cpu` backend
+//! on the same machine.
 //!
 //! Per case: the median and the fastest of `--runs` calls of [`VisibilityEngine::ambient`]
-//! on one engine (pipelines built once; each call uploads the scene, renders every depth map,
-//! tests every vertex and reads a_i back, as a deforming frame pays), after three warm-up
-//! calls; the CPU time the calling thread spent per call (recording, submission, driver:
-//! when it is close to the wall time the host is the limit, not the GPU); and what the speed
-//! costs in accuracy: the share of M's cells that differ from the `cpu` backend's exact M,
-//! and max |Δa_i|. The `cpu` backend's time (BVH build + trace, all threads) is measured on
-//! the same machine for the ratio.
+//! on one engine (pipelines built once; each call uploads the scene, renders every depth map
+//! or builds and uploads the BVH, tests every vertex and reads a_i back, as a deforming frame
+//! pays), after three warm-up calls; the CPU time the calling thread spent per call
+//! (recording, submission, driver, and `rays`' BVH build: when it is close to the wall time
+//! the host is the limit, not the GPU); and what the speed costs in accuracy: the share of
+//! M's cells that differ from the `cpu` backend's exact M, and max |Δa_i|. The `cpu`
+//! backend's time (BVH build + trace, all threads) is measured on the same machine for the
+//! ratio.
 //!
-//! Cases: the bunny at k = 6 … 1026 (depth maps of 1024²), the bunny at k = 1026 at 256² …
-//! 2048² and with batches of 16 and 256 layers, the dragon and igea at k = 258, a frame of
-//! the synthetic drape with its ball at k = 258 and 1026. `--quick` (for a software adapter):
-//! the bunny at k = 66 and 258, at 256² and 1024². Writes
-//! `target/repro/bench-visibility-gpu.md`. `--only MESH` keeps one mesh's rows.
+//! Cases: `depth` on the bunny at k = 6 … 1026 (depth maps of 1024²), the bunny at
+//! k = 1026 at 256² … 2048² and with batches of 16 and 256 layers, the dragon and igea at
+//! k = 258, a frame of the synthetic drape with its ball at k = 258 and 1026; `rays` beside
+//! every 1024² row. `--quick` (for a software adapter): the bunny at k = 66 and 258, `depth`
+//! at 256² and 1024², and `rays`. Writes `target/repro/bench-visibility-gpu.md`.
+//! `--only MESH` keeps one mesh's rows.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -31,9 +34,11 @@ use crate::repro_visibility::{ErrorStats, error_stats};
 /// Calls before the timed ones (shader compilation, first allocations).
 const WARM_UP_RUNS: usize = 3;
 
-/// One measured configuration of the `depth` backend.
+/// One measured configuration of a GPU backend.
+#[derive(Clone, Copy)]
 struct Setting {
     case: usize,
+    backend: Backend,
     resolution: u32,
     /// Layers per batch (`DepthParams::max_array_bytes` / layer bytes); `None`: the default.
     layers: Option<u64>,
@@ -121,6 +126,7 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
             for resolution in [256, 1024] {
                 let s = Setting {
                     case: 0,
+                    backend: Backend::Depth,
                     resolution,
                     layers: None,
                 };
@@ -131,6 +137,7 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
         for level in 0..=4 {
             let s = Setting {
                 case: 0,
+                backend: Backend::Depth,
                 resolution: 1024,
                 layers: None,
             };
@@ -139,6 +146,7 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
         for resolution in [256, 512, 2048] {
             let s = Setting {
                 case: 0,
+                backend: Backend::Depth,
                 resolution,
                 layers: None,
             };
@@ -147,6 +155,7 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
         for layers in [16, 256] {
             let s = Setting {
                 case: 0,
+                backend: Backend::Depth,
                 resolution: 1024,
                 layers: Some(layers),
             };
@@ -168,6 +177,7 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
             for &level in levels {
                 let s = Setting {
                     case: cases.len() - 1,
+                    backend: Backend::Depth,
                     resolution: 1024,
                     layers: None,
                 };
@@ -175,16 +185,29 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
             }
         }
     }
+    // The exact `rays` backend beside every default `depth` row.
+    let rays: Vec<(Setting, u32)> = settings
+        .iter()
+        .filter(|(s, _)| s.resolution == 1024 && s.layers.is_none())
+        .map(|&(s, level)| {
+            let s = Setting {
+                backend: Backend::Rays,
+                ..s
+            };
+            (s, level)
+        })
+        .collect();
+    settings.extend(rays);
     let mut table = String::new();
     writeln!(
         table,
-        "| mesh | N | k | depth map | maps per batch | median ms | fastest ms | host CPU \
-         ms | ms per direction | `cpu` ms (same machine) | `cpu` ÷ `depth` | cells ≠ exact \
-         | max \\|Δa\\| | vertices \\|Δa\\| > 0.05 |"
+        "| mesh | N | k | backend | depth map | maps per batch | median ms | fastest ms | host \
+         CPU ms | ms per direction | `cpu` ms (same machine) | `cpu` ÷ GPU | cells ≠ exact | \
+         max \\|Δa\\| | vertices \\|Δa\\| > 0.05 |"
     )?;
     writeln!(
         table,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     )?;
     let mut cache = Vec::new();
     for (setting, level) in &settings {
@@ -206,11 +229,16 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
             .clamp(1, u64::from(max_layers))
             .min(k as u64);
         let params = VisibilityParams::default().with_depth(depth);
-        let mut engine =
-            VisibilityEngine::with_gpu(&ctx.device, &ctx.queue, Backend::Depth, params);
+        let backend = setting.backend;
+        let mut engine = VisibilityEngine::with_gpu(&ctx.device, &ctx.queue, backend, params);
+        let (map, batch) = if backend == Backend::Depth {
+            (format!("{}²", setting.resolution), layers.to_string())
+        } else {
+            ("—".to_owned(), "—".to_owned())
+        };
         eprint!(
-            "{mesh} k = {k}, {}², {layers} maps per batch: ",
-            setting.resolution
+            "{mesh} k = {k}, {}, {map}, {batch} maps per batch: ",
+            backend.name()
         );
         for _ in 0..WARM_UP_RUNS {
             engine.ambient(&case.scene, &sphere)?;
@@ -235,27 +263,27 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
         let ErrorStats { max, off, .. } = error_stats(&matrix.ambient(), &exact.matrix.ambient());
         eprintln!("{wall_median:.2} ms (cpu {:.1} ms)", exact.millis);
         let n = case.scene.receiver_count();
-        let resolution = setting.resolution;
+        let name = backend.name();
         let host = host_median.map_or("—".to_owned(), |h| format!("{h:.2}"));
         let per_direction = wall_median / k as f64;
         let ratio = exact.millis / wall_median;
         let (cpu_ms, cells, off) = (exact.millis, cells * 100.0, off * 100.0);
         writeln!(
             table,
-            "| {mesh} | {n} | {k} | {resolution}² | {layers} | {wall_median:.2} | {fastest:.2} \
-             | {host} | {per_direction:.4} | {cpu_ms:.1} | {ratio:.2}× | {cells:.3} % | \
-             {max:.3} | {off:.2} % |"
+            "| {mesh} | {n} | {k} | `{name}` | {map} | {batch} | {wall_median:.2} | \
+             {fastest:.2} | {host} | {per_direction:.4} | {cpu_ms:.1} | {ratio:.2}× | \
+             {cells:.3} % | {max:.3} | {off:.2} % |"
         )?;
     }
     let threads = std::thread::available_parallelism().map_or(1, usize::from);
     let report = format!(
-        "# Visibility on the GPU: occlusion-gpu's `depth` backend\n\n\
+        "# Visibility on the GPU: occlusion-gpu's `depth` and `rays` backends\n\n\
          Adapter: {adapter}. `cpu` (exact, BVH build + trace) on the same machine's {threads} \
-         threads. Each `depth` time is the median of {runs} calls of `ambient` after \
-         {WARM_UP_RUNS} warm-up calls on one engine: scene upload, every depth map, the \
-         vertex tests and the read-back of a_i. Host CPU: what the calling thread spent per \
-         call (recording and submitting the passes). Cells ≠ exact: the share of M's cells \
-         where the depth maps decide differently from the exact ray cast.\n\n{table}\n\
+         threads. Each GPU time is the median of {runs} calls of `ambient` after \
+         {WARM_UP_RUNS} warm-up calls on one engine: scene upload (and for `rays` the BVH \
+         build), every depth map or ray, the read-back of a_i. Host CPU: what the calling \
+         thread spent per call (building, recording and submitting). Cells ≠ exact: the share \
+         of M's cells decided differently from the `cpu` backend's ray cast.\n\n{table}\n\
          Written by `cargo xtask bench visibility-gpu{}{}`.\n",
         if quick { " --quick" } else { "" },
         only.map_or(String::new(), |m| format!(" --only {m}"))

@@ -63,6 +63,7 @@ impl VisibilityStage {
             (VisibilityBackendDesc::Auto, _) if bounded => Backend::Cpu,
             (VisibilityBackendDesc::Depth, _) => Backend::Depth,
             (VisibilityBackendDesc::Query, _) => Backend::Query,
+            (VisibilityBackendDesc::Rays, _) => Backend::Rays,
             (VisibilityBackendDesc::Auto, Some(g)) if !g.summary().is_software => Backend::Depth,
             (VisibilityBackendDesc::Auto, _) => Backend::Cpu,
         };

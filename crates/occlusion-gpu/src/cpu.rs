@@ -167,7 +167,7 @@ pub(crate) const EDGE_TOLERANCE: f32 = 1e-6;
 /// (× 1 / × 3) 200 / 209 ms and a reinsertion ratio of 0.05 / 0.1 215 / 214 ms, against
 /// 207–219 ms for the preset itself: flat within the machine's noise, except fewer triangles
 /// per leaf (cost 1), which is slower.
-fn fan_build() -> BvhBuildParams {
+pub(crate) fn fan_build() -> BvhBuildParams {
     BvhBuildParams::fast_build()
 }
 

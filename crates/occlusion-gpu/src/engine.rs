@@ -6,7 +6,7 @@ use lightsphere::Lightsphere;
 use crate::cpu::{ColumnsTarget, CpuParams, Tracer, compute_columns};
 use crate::depth_params::DepthParams;
 #[cfg(feature = "gpu")]
-use crate::gpu::{DepthPipelines, DepthRun, GpuVisibility, QueryPipelines};
+use crate::gpu::{DepthPipelines, DepthRun, GpuVisibility, QueryPipelines, RayPipelines};
 use crate::progress::{ProgressFn, Ticker};
 use crate::scene::Prepared;
 use crate::{OcclusionError, Scene, VisibilityMatrix};
@@ -24,6 +24,11 @@ pub enum Backend {
     /// results are resolved and packed into M on the GPU. Slow by nature (N·k draws): the
     /// published baseline. Uses the [`DepthParams`] knobs of `depth`.
     Query,
+    /// GPU, exact: the `cpu` backend's rays (origin offset, [`CpuParams::max_distance`],
+    /// edge tolerance) cast by a compute shader through a BVH built on the CPU — M equals
+    /// `cpu`'s up to rays within rounding of a triangle edge or the tangent plane. No depth
+    /// map, so nothing of [`DepthParams`] applies.
+    Rays,
 }
 
 impl Backend {
@@ -33,6 +38,7 @@ impl Backend {
             Self::Cpu => "cpu",
             Self::Depth => "depth",
             Self::Query => "query",
+            Self::Rays => "rays",
         }
     }
 }
@@ -114,6 +120,11 @@ enum State {
     Query {
         gpu: Gpu,
         pipelines: Option<(DepthPipelines, QueryPipelines)>,
+    },
+    #[cfg(feature = "gpu")]
+    Rays {
+        gpu: Gpu,
+        pipelines: Option<RayPipelines>,
     },
 }
 
@@ -201,6 +212,10 @@ impl VisibilityEngine {
                 gpu,
                 pipelines: None,
             },
+            Backend::Rays => State::Rays {
+                gpu,
+                pipelines: None,
+            },
         };
         Self {
             state,
@@ -219,6 +234,8 @@ impl VisibilityEngine {
             State::Depth { .. } => Backend::Depth,
             #[cfg(feature = "gpu")]
             State::Query { .. } => Backend::Query,
+            #[cfg(feature = "gpu")]
+            State::Rays { .. } => Backend::Rays,
         }
     }
 
@@ -358,8 +375,8 @@ impl VisibilityEngine {
         Ok(())
     }
 
-    /// The ambient term a_i only. On the `depth` and `query` backends it is accumulated on the
-    /// GPU and only N floats are read back; on `cpu` it is derived from M.
+    /// The ambient term a_i only. On the GPU backends it is accumulated on the GPU and only N
+    /// floats are read back; on `cpu` it is derived from M.
     ///
     /// # Errors
     /// As [`VisibilityEngine::compute`].
@@ -442,7 +459,9 @@ impl VisibilityEngine {
         solid_angles: &[f64],
         first: usize,
     ) -> Result<(&Gpu, DepthRun), OcclusionError> {
+        self.check_params()?;
         let params = self.params.depth;
+        let cpu_params = self.params.cpu;
         let ticker = std::sync::Arc::new(self.ticker(
             prepared.receivers.len(),
             directions.len().saturating_sub(first),
@@ -485,7 +504,37 @@ impl VisibilityEngine {
                 )?;
                 Ok((gpu, run))
             }
+            State::Rays { gpu, pipelines } => {
+                let rays = pipelines.get_or_insert_with(|| RayPipelines::new(&gpu.device));
+                let run = rays.run(
+                    &gpu.device,
+                    &gpu.queue,
+                    prepared,
+                    directions,
+                    solid_angles,
+                    first,
+                    &cpu_params,
+                    &ticker,
+                )?;
+                Ok((gpu, run))
+            }
         }
+    }
+
+    /// Checks the parameters against the backend in use: the `cpu` knobs, and no
+    /// `max_distance` on the depth-map backends (they cannot bound their rays).
+    fn check_params(&self) -> Result<(), OcclusionError> {
+        self.params.cpu.validate()?;
+        let max_distance = self.params.cpu.max_distance;
+        if max_distance.is_finite() && matches!(self.backend(), Backend::Depth | Backend::Query) {
+            return Err(OcclusionError::InvalidParameter {
+                what: "max_distance",
+                value: f64::from(max_distance),
+                expected: "infinite on the depth and query backends (only the cpu and rays \
+                           backends bound their rays)",
+            });
+        }
+        Ok(())
     }
 
     /// Computes the columns `first_new..k` of `matrix`.
@@ -497,16 +546,7 @@ impl VisibilityEngine {
     ) -> Result<(), OcclusionError> {
         let k = matrix.directions_len();
         self.last_rays = 0;
-        self.params.cpu.validate()?;
-        let max_distance = self.params.cpu.max_distance;
-        if max_distance.is_finite() && !matches!(self.state, State::Cpu { .. }) {
-            return Err(OcclusionError::InvalidParameter {
-                what: "max_distance",
-                value: f64::from(max_distance),
-                expected: "infinite on the depth and query backends (only the cpu backend \
-                           bounds its rays)",
-            });
-        }
+        self.check_params()?;
         if first_new >= k {
             return Ok(());
         }
@@ -573,7 +613,7 @@ impl VisibilityEngine {
                 Ok(())
             }
             #[cfg(feature = "gpu")]
-            State::Depth { .. } | State::Query { .. } => {
+            State::Depth { .. } | State::Query { .. } | State::Rays { .. } => {
                 let directions = matrix.directions().to_vec();
                 let solid_angles = matrix.solid_angles().to_vec();
                 let (gpu, run) = self.run_gpu(prepared, &directions, &solid_angles, first_new)?;

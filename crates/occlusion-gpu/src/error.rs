@@ -138,6 +138,18 @@ pub enum OcclusionError {
         /// The device's maximum.
         maximum: u64,
     },
+    /// The scene's BVH is deeper than the `rays` backend's shader can walk (its stack holds a
+    /// fixed number of nodes; real meshes build trees 13–24 deep).
+    #[error(
+        "the scene's BVH is {depth} nodes deep and the rays backend walks at most {maximum}: \
+         use the cpu backend (the same exact rays)"
+    )]
+    BvhTooDeep {
+        /// Nodes on the tree's longest root-to-leaf path.
+        depth: u64,
+        /// The most the shader's stack holds.
+        maximum: u64,
+    },
     /// A GPU-resident result was asked of a backend that computes M on the CPU.
     #[error(
         "backend {backend} computes M on the CPU and has no GPU-resident result; use the depth \

@@ -11,8 +11,8 @@
 //! precomputation: a deforming mesh recomputes M per frame, and a finer lightsphere level
 //! reuses the columns already computed ([`VisibilityEngine::refine`], §3.4, §4.2).
 //!
-//! Feature `gpu` (default) builds the `Depth` and `Query` backends, M resident on the GPU and
-//! the triangle-id pass of vertex filtering on wgpu; without it the crate is the exact CPU
+//! Feature `gpu` (default) builds the `Depth`, `Query` and `Rays` backends, M resident on the
+//! GPU and the triangle-id pass of vertex filtering on wgpu; without it the crate is the exact CPU
 //! engine (rays, fans, [`RayCaster`], vertex filtering with the CPU rasteriser, levels, rigid
 //! look-ups) with no GPU stack to build.
 //!
@@ -36,14 +36,23 @@
 //!   orthographic depth map, then every vertex drawn as a point (depth test LessEqual, no
 //!   depth write) inside its own hardware occlusion query; a vertex with a sample passing is
 //!   visible, M_ij = n_i·l_j. The bias of `glPolygonOffset(1, 1)` is applied in the vertex
-//!   shader with the `Depth` backend's formula, so the two GPU backends agree up to vertices
-//!   whose biased depth lies within rounding of the stored depth (the rasteriser's depth of
-//!   a point and the compute shader's clip z round differently): on lavapipe 0–18 of the
-//!   bunny's 34,834 used vertices and 0–63 of the cloth's 4,356 differ at 512²–1024²,
-//!   levels 0–4 (`cargo xtask repro visibility`). Unlike the seed, whose §8.1 names the per-query read-back as its drawback,
-//!   the query results are resolved into a GPU buffer per batch of ≤ 4096-query sets and
-//!   packed into the same bits and a_i buffers by a compute pass: no stall, no read-back per
-//!   query. Slow by nature (N·k draws): the published baseline.
+//!   shader with the `Depth` backend's formula, so the two depth-map backends agree up to
+//!   vertices whose biased depth lies within rounding of the stored depth (the rasteriser's
+//!   depth of a point and the compute shader's clip z round differently): on lavapipe 0–18
+//!   of the bunny's 34,834 used vertices and 0–63 of the cloth's 4,356 differ at
+//!   512²–1024², levels 0–4 (`cargo xtask repro visibility`). Unlike the seed, whose §8.1
+//!   names the per-query read-back as its drawback, the query results are resolved into a
+//!   GPU buffer per batch of ≤ 4096-query sets and packed into the same bits and a_i buffers
+//!   by a compute pass: no stall, no read-back per query. Slow by nature (N·k draws): the
+//!   published baseline.
+//! * `Rays` — the `cpu` backend's exact rays cast on the GPU: the BVH built on the CPU
+//!   (`obvhs` PLOC, padded boxes), origins rounded as the CPU rounds them, and a compute
+//!   shader that walks the tree per (vertex, word of 32 directions) with the CPU's
+//!   Möller–Trumbore test and edge tolerance. No map, no bias, no resolution: M equals
+//!   `cpu`'s up to rays within rounding of an edge or the tangent plane (the full bunny at
+//!   k = 258: identical, M's hash; 2 grazing rays of the sphere over a plane's 285,606), and
+//!   [`CpuParams::max_distance`] applies. For GPUs that rasterise slowly; not yet timed on
+//!   one (lavapipe: 3.6 s for the bunny at k = 258, compute emulated on the CPU).
 //!
 //! Which backend is fastest depends on the machine. On an NVIDIA H100 (Vulkan, driver
 //! 580.159.04, `cargo xtask bench visibility-gpu`, medians of 21 frames) the full bunny at
@@ -52,9 +61,10 @@
 //! of its chip (0.4 ms per 1024² depth map of the bunny's 69k triangles), so there `Cpu` is
 //! both exact and faster. `Depth` wins at small k (the bunny at k = 6: 4.3 against 24.7 ms)
 //! and on dense meshes at moderate k (k = 258: the 100k-vertex dragon 127 against 257 ms,
-//! igea 169 against 257 ms). GPUs built for raster were not measured.
+//! igea 169 against 257 ms). GPUs built for raster were not measured, nor `Rays` on any
+//! GPU (it was written after that loan ended).
 //!
-//! Both GPU backends can keep their result on the GPU:
+//! Every GPU backend can keep its result on the GPU:
 //! [`VisibilityEngine::compute_resident`] returns a [`GpuVisibility`] whose bits and a_i
 //! buffers a renderer binds directly — M stays on the GPU from frame to frame, and only what
 //! is asked for is read back (§8.1).

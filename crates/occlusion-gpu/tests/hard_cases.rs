@@ -318,7 +318,7 @@ fn extreme_scene_scales_give_the_same_matrix() {
 }
 
 /// Hard case: the scene's units. The same sphere over a plane at 2⁻⁸⁰ … 2⁵⁵ (power-of-two
-/// scales commute with f32 rounding) must give the same M on both GPU backends as at scale 1
+/// scales commute with f32 rounding) must give the same M on every GPU backend as at scale 1
 /// (before the upload was scaled, 6,009 of the 19,926 cells differed at 2⁻⁸⁰ on `depth`,
 /// 1,392 on `query`).
 #[cfg(feature = "gpu")]
@@ -341,7 +341,7 @@ fn extreme_scene_scales_give_the_same_gpu_matrix() {
             .compute(&scene, &sphere)
             .unwrap()
     };
-    for backend in [Backend::Depth, Backend::Query] {
+    for backend in [Backend::Depth, Backend::Query, Backend::Rays] {
         let reference = matrix(1.0, backend);
         let open = reference.visible_count();
         assert!(open > 0 && open < reference.rows() * sphere.len());
@@ -442,4 +442,48 @@ fn unreferenced_vertices_and_degenerate_triangles() {
     }
     let radiance = matrix.radiance(&vec![Vec3::ONE; sphere.len()]).unwrap();
     assert!(radiance[last].is_nan() && radiance[0].is_finite());
+}
+
+/// Hard case: a BVH deeper than the `rays` shader's stack (64 nodes; real meshes build 13–24)
+/// — here 120 triangles at x = 1.6^i, which the build chains about 100 deep — is refused with
+/// [`OcclusionError::BvhTooDeep`], never walked with a truncated stack; the `cpu` backend
+/// computes the same scene.
+#[cfg(feature = "gpu")]
+#[test]
+fn a_bvh_deeper_than_the_gpu_stack_is_refused_not_walked() {
+    use occlusion_gpu::{Backend, OcclusionError, SceneObject};
+    let Some(ctx) = gpu_context::testing::gpu_or_skip() else {
+        return;
+    };
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for i in 0..120 {
+        let x = 1.6f32.powi(i);
+        let base = positions.len() as u32;
+        positions.extend([
+            Vec3::new(x, 0.0, 0.0),
+            Vec3::new(x, 0.01 * x, 0.0),
+            Vec3::new(x, 0.0, 0.01 * x),
+        ]);
+        triangles.push([base, base + 1, base + 2]);
+    }
+    let normals = vec![Vec3::X; positions.len()];
+    let mut scene = Scene::new();
+    scene
+        .push(SceneObject::new(positions, normals, triangles))
+        .unwrap();
+    let sphere = Lightsphere::new(1).unwrap();
+    let params = VisibilityParams::default();
+    let mut rays = VisibilityEngine::with_gpu(&ctx.device, &ctx.queue, Backend::Rays, params);
+    match rays.compute(&scene, &sphere) {
+        Err(e @ OcclusionError::BvhTooDeep { depth, maximum }) => {
+            assert!(depth > maximum && maximum == 64, "{depth} > {maximum}");
+            assert!(e.to_string().contains("use the cpu backend"), "{e}");
+        }
+        other => panic!("expected BvhTooDeep, got {other:?}"),
+    }
+    assert!(rays.ambient(&scene, &sphere).is_err());
+    VisibilityEngine::cpu(params)
+        .compute(&scene, &sphere)
+        .unwrap();
 }

@@ -91,7 +91,7 @@ fn gpu_backends_count_every_batch_when_the_device_finishes_it() {
     let mut depth = DepthParams::default().with_resolution(256);
     depth.max_array_bytes = 16 * 256 * 256 * 4;
     let params = VisibilityParams::default().with_depth(depth);
-    for backend in [Backend::Depth, Backend::Query] {
+    for backend in [Backend::Depth, Backend::Query, Backend::Rays] {
         let mut quiet = VisibilityEngine::with_gpu(&ctx.device, &ctx.queue, backend, params);
         let expected = compute(&mut quiet, &scene, &sphere);
         let seen = Arc::new(Seen::default());

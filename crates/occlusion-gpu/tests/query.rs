@@ -169,14 +169,14 @@ fn refine_and_gpu_ambient_are_consistent() {
     }
 }
 
-/// The resident handle reads back exactly what `compute` and `ambient` return, on both GPU
-/// backends, and exposes buffers of the documented size; `cpu` has no resident result.
+/// The resident handle reads back exactly what `compute` and `ambient` return, on every GPU
+/// backend, and exposes buffers of the documented size; `cpu` has no resident result.
 #[test]
 fn resident_results_equal_compute_and_ambient() {
     let Some(ctx) = gpu() else { return };
     let scene = sphere_over_plane();
     let sphere = Lightsphere::new(2).unwrap();
-    for backend in [Backend::Query, Backend::Depth] {
+    for backend in [Backend::Query, Backend::Depth, Backend::Rays] {
         let mut engine = engine(&ctx, backend, 256);
         let resident = engine.compute_resident(&scene, &sphere).unwrap();
         let matrix = engine.compute(&scene, &sphere).unwrap();
@@ -213,15 +213,17 @@ fn zero_normal_vertices_have_empty_rows() {
     mesh.normals.push(glam::Vec3::ZERO);
     let scene = Scene::single(mesh.positions, mesh.normals, mesh.triangles).unwrap();
     let sphere = Lightsphere::new(2).unwrap();
-    let mut engine = engine(&ctx, Backend::Query, 256);
-    let matrix = engine.compute(&scene, &sphere).unwrap();
-    let last = matrix.rows() - 1;
-    assert!((0..sphere.len()).all(|j| !matrix.is_visible(last, j)));
-    let ambient = engine.ambient(&scene, &sphere).unwrap();
-    assert!(ambient[last].is_nan());
-    let up = open_ambient(&sphere, glam::DVec3::Y);
-    for a in &ambient[..last] {
-        assert_close(f64::from(*a), up, 1e-5, "open grid vertex");
+    for backend in [Backend::Query, Backend::Rays] {
+        let mut engine = engine(&ctx, backend, 256);
+        let matrix = engine.compute(&scene, &sphere).unwrap();
+        let last = matrix.rows() - 1;
+        assert!((0..sphere.len()).all(|j| !matrix.is_visible(last, j)));
+        let ambient = engine.ambient(&scene, &sphere).unwrap();
+        assert!(ambient[last].is_nan());
+        let up = open_ambient(&sphere, glam::DVec3::Y);
+        for a in &ambient[..last] {
+            assert_close(f64::from(*a), up, 1e-5, "open grid vertex");
+        }
     }
 }
 

@@ -83,10 +83,11 @@ pub struct BakeArgs {
     /// Lightsphere level s (k = 2 + 4^(s+1) directions), as for `visibility`.
     #[arg(long, default_value_t = 3)]
     level: u32,
-    /// Backend: cpu (exact rays), depth or query (GPU); default as for `visibility`.
-    #[arg(long, value_parser = ["depth", "query", "cpu"])]
+    /// Backend: cpu (exact rays), rays (the same exact rays on the GPU), depth or query (GPU
+    /// depth maps); default as for `visibility`.
+    #[arg(long, value_parser = ["depth", "query", "cpu", "rays"])]
     backend: Option<String>,
-    /// Occluders farther than D (the asset's units) are ignored (cpu backend).
+    /// Occluders farther than D (the asset's units) are ignored (cpu and rays backends).
     #[arg(long, value_name = "D")]
     max_distance: Option<f32>,
     /// Where a_i goes in a glTF: COLOR_0 (RGB), COLOR_0.a (alpha over the existing colour) or
@@ -242,6 +243,7 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         Some("cpu") => VisibilityBackendDesc::Cpu,
         Some("depth") => VisibilityBackendDesc::Depth,
         Some("query") => VisibilityBackendDesc::Query,
+        Some("rays") => VisibilityBackendDesc::Rays,
         _ => VisibilityBackendDesc::Auto,
     };
     if let Some(d) = args.max_distance {
@@ -254,16 +256,18 @@ pub fn bake(args: &BakeArgs) -> Result<BakeSummary, Error> {
         if matches!(args.backend.as_deref(), Some("depth" | "query")) {
             return Err(invalid(
                 input,
-                "--max-distance needs the cpu backend (exact rays)".into(),
+                "--max-distance needs the cpu or rays backend (exact rays)".into(),
             ));
         }
     }
     scene.visibility.max_distance = args.max_distance;
     let environment = args.environment.load_turned()?;
     let gpu = match scene.visibility.backend {
-        VisibilityBackendDesc::Depth | VisibilityBackendDesc::Query => Some(
-            gpu_context::GpuContext::new(&gpu_context::GpuOptions::default())?,
-        ),
+        VisibilityBackendDesc::Depth
+        | VisibilityBackendDesc::Query
+        | VisibilityBackendDesc::Rays => Some(gpu_context::GpuContext::new(
+            &gpu_context::GpuOptions::default(),
+        )?),
         VisibilityBackendDesc::Auto if args.max_distance.is_none() => super::optional_gpu(),
         _ => None,
     };

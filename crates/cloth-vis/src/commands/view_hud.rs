@@ -132,9 +132,14 @@ impl Hud<'_> {
                         use cloth_vis::scene::VisibilityBackendDesc as B;
                         ui.horizontal(|ui| {
                             ui.label("M by");
-                            for (b, name) in
-                                [(B::Auto, "auto"), (B::Cpu, "cpu"), (B::Depth, "depth"), (B::Query, "query")]
-                            {
+                            let backends = [
+                                (B::Auto, "auto"),
+                                (B::Cpu, "cpu"),
+                                (B::Depth, "depth"),
+                                (B::Query, "query"),
+                                (B::Rays, "rays"),
+                            ];
+                            for (b, name) in backends {
                                 ui.radio_value(&mut settings.backend, b, name);
                             }
                         });

@@ -334,6 +334,7 @@ fn one_object_scene(request: &VisibilityRequest) -> Result<Scene, Error> {
         Some(Backend::Cpu) => VisibilityBackendDesc::Cpu,
         Some(Backend::Depth) => VisibilityBackendDesc::Depth,
         Some(Backend::Query) => VisibilityBackendDesc::Query,
+        Some(Backend::Rays) => VisibilityBackendDesc::Rays,
     };
     scene.visibility.depth_resolution = request.depth_resolution;
     turn_camera(&mut scene.camera, request.up_axis);
@@ -665,9 +666,9 @@ pub struct VisibilityArgs {
     #[arg(long, default_value_t = 3)]
     level: u32,
     /// Backend: depth (GPU depth maps), query (the published per-vertex occlusion
-    /// queries; slow, N·k draws) or cpu (exact ray casting); default depth on a hardware
-    /// GPU, cpu otherwise.
-    #[arg(long, value_parser = ["depth", "query", "cpu"])]
+    /// queries; slow, N·k draws), cpu (exact ray casting) or rays (the same exact rays cast
+    /// on the GPU); default depth on a hardware GPU, cpu otherwise.
+    #[arg(long, value_parser = ["depth", "query", "cpu", "rays"])]
     backend: Option<String>,
     /// Depth-map side for the depth and query backends.
     #[arg(long, default_value_t = occlusion_gpu::DEFAULT_DEPTH_RESOLUTION)]
@@ -719,12 +720,13 @@ impl VisibilityArgs {
         let backend = self.backend.as_deref().map(|b| match b {
             "cpu" => Backend::Cpu,
             "query" => Backend::Query,
+            "rays" => Backend::Rays,
             _ => Backend::Depth,
         });
         let gpu = match backend {
             Some(Backend::Cpu) if self.render.is_none() => None,
             // A GPU backend without an adapter fails here, with gpu-context's advice.
-            Some(Backend::Depth | Backend::Query) => {
+            Some(Backend::Depth | Backend::Query | Backend::Rays) => {
                 Some(GpuContext::new(&gpu_context::GpuOptions::default())?)
             }
             _ => match &self.render {

@@ -102,6 +102,7 @@ impl std::fmt::Display for ViewEvent {
                     B::Cpu => "cpu",
                     B::Depth => "depth",
                     B::Query => "query",
+                    B::Rays => "rays",
                 };
                 match side {
                     Some(side) => write!(f, "backend {name} {side}"),
@@ -232,7 +233,8 @@ fn parse_line(line: &str) -> Result<ViewEvent, String> {
                 "cpu" => B::Cpu,
                 "depth" => B::Depth,
                 "query" => B::Query,
-                other => return Err(format!("{other:?} is not auto, cpu, depth or query")),
+                "rays" => B::Rays,
+                other => return Err(format!("{other:?} is not auto, cpu, depth, query or rays")),
             };
             let side = match args.get(1) {
                 None => None,

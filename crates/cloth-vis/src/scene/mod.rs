@@ -236,6 +236,8 @@ pub enum VisibilityBackendDesc {
     Depth,
     /// The published per-vertex hardware occlusion queries (paper 000 §3.2; slow: N·k draws).
     Query,
+    /// Exact ray casting on the GPU (a compute shader; `cpu`'s answers).
+    Rays,
 }
 
 /// Visibility parameters.
@@ -248,7 +250,7 @@ pub struct VisibilityDesc {
     /// Depth-map side for the `depth` backend.
     #[serde(default = "default_depth_resolution")]
     pub depth_resolution: u32,
-    /// Occluders farther than this along a ray are ignored (world units; `cpu` backend only;
+    /// Occluders farther than this along a ray are ignored (world units; `cpu` and `rays` only;
     /// unset: unbounded, paper 000's visibility).
     #[serde(default)]
     pub max_distance: Option<f32>,
@@ -547,7 +549,8 @@ impl Scene {
                 VisibilityBackendDesc::Depth | VisibilityBackendDesc::Query
             );
             if !(d.is_finite() && d > 0.0 && cpu) {
-                let why = "must be finite and > 0, on the cpu backend (the only one bounding rays)";
+                let why = "must be finite and > 0, on the cpu or rays backend (the only ones \
+                           bounding rays)";
                 return Err(self.invalid("visibility.max_distance", format!("{d} {why}")));
             }
         }

@@ -30,6 +30,7 @@
 
 mod light;
 mod query;
+mod rays;
 mod resident;
 
 use glam::Vec3;
@@ -37,6 +38,7 @@ use wgpu::util::DeviceExt;
 
 pub(crate) use light::LightBox;
 pub(crate) use query::QueryPipelines;
+pub(crate) use rays::RayPipelines;
 pub use resident::GpuVisibility;
 
 pub(crate) use crate::depth_params::DepthParams;
@@ -403,7 +405,7 @@ pub(crate) fn check_resolution(
     Ok(resolution)
 }
 
-/// The GPU buffers both GPU backends share for one computation: lights, receivers, the
+/// The GPU buffers the two depth-map backends share for one computation: lights, receivers, the
 /// scene's geometry, and the zero-initialised outputs (visibility bits, a_i).
 pub(crate) struct SceneBuffers {
     pub light_box: LightBox,
@@ -425,8 +427,8 @@ impl SceneBuffers {
     /// brings the diagonal into (8, 16] (as the `cpu` backend's tracers do): the shaders' f32
     /// products then never underflow or overflow, so a scene 10⁻²⁴ or 10¹⁶ across gets the M
     /// of the same scene in metres, bit for bit (a power of two commutes with f32 rounding).
-    /// Without it both GPU backends got a third of the cells of a sphere over a plane wrong at
-    /// 2⁻⁸⁰.
+    /// Without it both depth-map backends got a third of the cells of a sphere over a plane
+    /// wrong at 2⁻⁸⁰.
     pub(crate) fn new(
         device: &wgpu::Device,
         prepared: &Prepared,
