@@ -14,7 +14,7 @@
 //! level 2             # lightsphere level
 //! rotation 45         # environment turn in degrees
 //! light 0 3 2         # the first point light of shadow volumes / translucency, moved
-//! backend depth 512   # M by GPU depth maps of side 512 (auto, cpu, depth, query)
+//! backend depth 512   # M by GPU depth maps of side 512 (auto, cpu, depth, query, rays)
 //! exposure -1         # EV; `exposure auto` returns to the scene's
 //! tone clamp          # tone curve: aces, clamp (γ 2.2), srgb
 //! environment 1       # 0: the scene's map, then each `--env` map
@@ -225,7 +225,8 @@ fn parse_line(line: &str) -> Result<ViewEvent, String> {
             use crate::scene::VisibilityBackendDesc as B;
             if !(1..=2).contains(&args.len()) {
                 return Err(
-                    "takes a backend (auto, cpu, depth, query) and for depth a map side".to_owned(),
+                    "takes a backend (auto, cpu, depth, query, rays) and for depth a map side"
+                        .to_owned(),
                 );
             }
             let backend = match args[0] {
@@ -356,7 +357,7 @@ mod tests {
                     off shadow-volumes\non btf\nlevel 2\nrotation 45\nexposure -1.25\n\
                     exposure auto\nframe 7\nbtf-plain on\nbtf-plain off\nplay\npause\n\
                     next-cell\nlight 0 3 -2.5\nbackend depth 512\nbackend cpu\nbackend auto\n\
-                    backend query\nenvironment 2\ntone srgb\ntone aces\ntone clamp\n";
+                    backend query\nbackend rays\nenvironment 2\ntone srgb\ntone aces\ntone clamp\n";
         let events = parse_events(text).unwrap();
         let printed: Vec<String> = events.iter().map(ToString::to_string).collect();
         assert_eq!(printed, text.lines().collect::<Vec<_>>());
@@ -374,7 +375,10 @@ mod tests {
             ("jump", "unknown event \"jump\""),
             ("frame -1", "\"-1\" is not a frame index"),
             ("light 1 2", "takes three numbers"),
-            ("backend gpu", "\"gpu\" is not auto, cpu, depth or query"),
+            (
+                "backend gpu",
+                "\"gpu\" is not auto, cpu, depth, query or rays",
+            ),
             ("backend depth 0", "\"0\" is not a depth-map side"),
         ] {
             let e = parse_events(text).unwrap_err();
