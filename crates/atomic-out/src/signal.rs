@@ -61,7 +61,27 @@ fn remove_temporaries_and_exit() {
     for dir in crate::parents::created().iter().rev() {
         let _ = std::fs::remove_dir(dir);
     }
-    std::process::exit(EXIT_STATUS_ON_SIGNAL);
+    exit_now(EXIT_STATUS_ON_SIGNAL)
+}
+
+/// Ends the process without the C libraries' exit handlers. `std::process::exit` runs them
+/// (`atexit`, static destructors) while the program's other threads are still running — in a
+/// program that renders, inside Mesa's and LLVM's code — which tears their state down under
+/// those threads: one CI run (2 cores, under load) saw the killed `demo` end with SIGSEGV
+/// instead of 130, after the temporaries had gone. Rust's own buffered stdout is not flushed
+/// either way that matters here: an interrupted command prints no summary.
+#[cfg(unix)]
+#[allow(unsafe_code)]
+fn exit_now(status: i32) -> ! {
+    // SAFETY: `_exit` takes a plain integer, touches no memory of this process and does not
+    // return; it is async-signal-safe.
+    unsafe { libc::_exit(status) }
+}
+
+/// [`std::process::exit`] where `_exit` is not available.
+#[cfg(not(unix))]
+fn exit_now(status: i32) -> ! {
+    std::process::exit(status)
 }
 
 /// Removes a temporary folder that another thread may still be writing into. It is first

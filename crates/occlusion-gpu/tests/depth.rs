@@ -141,3 +141,47 @@ fn depth_backend_offsets_scales_and_two_sided_sheets() {
         "two-sided sheet: mean {mean}, share {share}"
     );
 }
+
+/// A finite `max_distance` is refused by the depth-map backends on every path (`compute`,
+/// `ambient`, `compute_resident`): they cannot bound their rays, and `ambient` used to skip
+/// the check and silently return unbounded a_i. `rays` bounds them like `cpu`.
+#[test]
+fn depth_map_backends_refuse_a_max_distance_on_every_path() {
+    let Some(ctx) = gpu() else { return };
+    let scene = sphere_over_plane();
+    let sphere = Lightsphere::new(1).unwrap();
+    let params = VisibilityParams::default()
+        .with_cpu(occlusion_gpu::CpuParams::default().with_max_distance(0.45));
+    for backend in [Backend::Depth, Backend::Query] {
+        let mut engine = VisibilityEngine::with_gpu(&ctx.device, &ctx.queue, backend, params);
+        let refused = |e: &occlusion_gpu::OcclusionError| {
+            matches!(
+                e,
+                occlusion_gpu::OcclusionError::InvalidParameter {
+                    what: "max_distance",
+                    ..
+                }
+            )
+        };
+        assert!(refused(&engine.compute(&scene, &sphere).unwrap_err()));
+        assert!(refused(&engine.ambient(&scene, &sphere).unwrap_err()));
+        assert!(refused(
+            &engine.compute_resident(&scene, &sphere).err().unwrap()
+        ));
+    }
+    // On `rays` the bound takes effect on the a_i-only path too: only occluders beyond 0.45
+    // are dropped, so no vertex sees less sky and some see more.
+    let rays = |params| {
+        VisibilityEngine::with_gpu(&ctx.device, &ctx.queue, Backend::Rays, params)
+            .ambient(&scene, &sphere)
+            .unwrap()
+    };
+    let (bounded, unbounded) = (rays(params), rays(VisibilityParams::default()));
+    assert!(
+        bounded
+            .iter()
+            .zip(&unbounded)
+            .all(|(b, u)| b >= u || b.is_nan())
+    );
+    assert!(bounded.iter().zip(&unbounded).any(|(b, u)| b > u));
+}

@@ -242,7 +242,7 @@ fn hostile_bakes_are_refused_before_writing() {
                 "--backend",
                 "depth",
             ],
-            "cpu backend",
+            "needs the cpu or rays backend",
         ),
         (&["--out", text(&escaping)], "is the input"),
     ];
