@@ -53,6 +53,14 @@ const WORKGROUP_SIZE: u32 = 64;
 /// Largest workgroup count per dispatch dimension guaranteed by WebGPU.
 const MAX_GROUPS_PER_DIMENSION: u32 = 65_535;
 
+/// Workgroups (x, y) of [`WORKGROUP_SIZE`] covering `invocations`, x within WebGPU's
+/// per-dimension limit (the shaders rebuild the index as `id.x + id.y · groups.x · 64`).
+pub(crate) fn workgroups(invocations: usize) -> (u32, u32) {
+    let groups = (invocations as u32).div_ceil(WORKGROUP_SIZE);
+    let x = groups.clamp(1, MAX_GROUPS_PER_DIMENSION);
+    (x, groups.div_ceil(x).max(1))
+}
+
 const DEPTH_SHADER: &str = include_str!("occlusion_depth.wgsl");
 const TEST_SHADER: &str = include_str!("occlusion_test.wgsl");
 
@@ -288,9 +296,7 @@ impl DepthPipelines {
             ],
         });
         let texel_world = 2.0 * light_box.half_extent / resolution as f32;
-        let groups = (rows as u32).div_ceil(WORKGROUP_SIZE);
-        let groups_x = groups.min(MAX_GROUPS_PER_DIMENSION);
-        let groups_y = groups.div_ceil(groups_x.max(1));
+        let (groups_x, groups_y) = workgroups(rows);
         let mut first_direction = first;
         while first_direction < k {
             let layer_count = layers.min(k - first_direction);

@@ -22,10 +22,7 @@
 use glam::Vec3;
 use wgpu::{QUERY_SET_MAX_QUERIES, QUERY_SIZE};
 
-use super::{
-    DepthParams, DepthPipelines, DepthRun, MAX_GROUPS_PER_DIMENSION, SceneBuffers, WORKGROUP_SIZE,
-    check_resolution, storage_entry,
-};
+use super::{DepthParams, DepthPipelines, DepthRun, SceneBuffers, check_resolution, storage_entry};
 use crate::OcclusionError;
 use crate::progress::Ticker;
 use crate::scene::Prepared;
@@ -289,9 +286,7 @@ impl QueryPipelines {
                 &scene.ambient,
             ]),
         });
-        let groups = (rows as u32).div_ceil(WORKGROUP_SIZE);
-        let groups_x = groups.min(MAX_GROUPS_PER_DIMENSION);
-        let groups_y = groups.div_ceil(groups_x.max(1));
+        let (groups_x, groups_y) = super::workgroups(rows);
 
         let mut first_direction = first;
         while first_direction < k {

@@ -14,7 +14,7 @@ use gpu_context::layout::{self, binding};
 use gpu_context::pipeline;
 use wgpu::util::DeviceExt;
 
-use super::{DepthRun, MAX_GROUPS_PER_DIMENSION, WORKGROUP_SIZE};
+use super::{DepthRun, workgroups};
 use crate::OcclusionError;
 use crate::cpu::{CpuParams, fan_build};
 use crate::matrix::WORD_BITS;
@@ -256,6 +256,22 @@ impl RayPipelines {
             call_word_count: call_word_count as u32,
             _pad: [0; 2],
         };
+        // One compute pass of `pipeline` over `invocations`, submitted on its own.
+        let dispatch = |pipeline: &wgpu::ComputePipeline, label, invocations| {
+            let mut encoder = device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(label),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &group, &[]);
+                let (x, y) = workgroups(invocations);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            queue.submit([encoder.finish()]);
+        };
         // Each submission takes whole words of every row; its own copy of the parameters
         // (a uniform rewritten between submissions is read by the later one only).
         let words_per_submission = (CELLS_PER_SUBMISSION / rows.max(1)).max(1);
@@ -268,20 +284,7 @@ impl RayPipelines {
                 ..base
             };
             queue.write_buffer(&params_buffer, 0, bytemuck::bytes_of(&batch));
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("occlusion rays"),
-            });
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("occlusion rays"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&self.trace);
-                pass.set_bind_group(0, &group, &[]);
-                let (x, y) = groups(rows * count);
-                pass.dispatch_workgroups(x, y, 1);
-            }
-            queue.submit([encoder.finish()]);
+            dispatch(&self.trace, "occlusion rays", rows * count);
             let done = std::sync::Arc::clone(ticker);
             let columns =
                 (((word + count) * WORD_BITS).min(k) - (word * WORD_BITS).max(first)) as u64;
@@ -292,20 +295,7 @@ impl RayPipelines {
             word += count;
         }
         queue.write_buffer(&params_buffer, 0, bytemuck::bytes_of(&base));
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("occlusion rays: a_i"),
-        });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("occlusion rays: a_i"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.sum_rows);
-            pass.set_bind_group(0, &group, &[]);
-            let (x, y) = groups(rows);
-            pass.dispatch_workgroups(x, y, 1);
-        }
-        queue.submit([encoder.finish()]);
+        dispatch(&self.sum_rows, "occlusion rays: a_i", rows);
         Ok(DepthRun {
             bits,
             ambient,
@@ -318,13 +308,6 @@ impl RayPipelines {
                 .collect(),
         })
     }
-}
-
-/// Workgroups (x, y) covering `invocations`, x within WebGPU's per-dimension limit.
-fn groups(invocations: usize) -> (u32, u32) {
-    let groups = (invocations as u32).div_ceil(WORKGROUP_SIZE);
-    let x = groups.clamp(1, MAX_GROUPS_PER_DIMENSION);
-    (x, groups.div_ceil(x).max(1))
 }
 
 /// The most nodes on a root-to-leaf path of a tree whose inner nodes' children sit at
