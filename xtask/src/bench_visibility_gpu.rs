@@ -6,7 +6,8 @@
 //! Per case: the median and the fastest of `--runs` calls of [`VisibilityEngine::ambient`]
 //! on one engine (pipelines built once; each call uploads the scene, renders every depth map
 //! or builds and uploads the BVH, tests every vertex and reads a_i back, as a deforming frame
-//! pays), after three warm-up calls; the CPU time the calling thread spent per call
+//! pays — `rays` keeps its tree for an unchanged scene, so its calls alternate between the
+//! scene and a copy 1 + 2⁻²⁰ times larger, with refitting off), after three warm-up calls; the CPU time the calling thread spent per call
 //! (recording, submission, driver, and `rays`' BVH build: when it is close to the wall time
 //! the host is the limit, not the GPU); and what the speed costs in accuracy: the share of
 //! M's cells that differ from the `cpu` backend's exact M, and max |Δa_i|. The `cpu`
@@ -228,8 +229,14 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
         let layers = (depth.max_array_bytes / layer_bytes)
             .clamp(1, u64::from(max_layers))
             .min(k as u64);
-        let params = VisibilityParams::default().with_depth(depth);
+        // `rays` reuses its tree while the scene is unchanged and refits it when only
+        // positions move: off, and every other call on a copy scaled by 1 + 2⁻²⁰, so that each
+        // call builds its tree as a deforming frame without refits would.
+        let cpu = occlusion_gpu::CpuParams::default().with_refit(false);
+        let params = VisibilityParams::default().with_depth(depth).with_cpu(cpu);
         let backend = setting.backend;
+        let twin = rebuilt_twin(&case.scene);
+        let scenes = [&case.scene, &twin];
         let mut engine = VisibilityEngine::with_gpu(&ctx.device, &ctx.queue, backend, params);
         let (map, batch) = if backend == Backend::Depth {
             (format!("{}²", setting.resolution), layers.to_string())
@@ -240,14 +247,14 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
             "{mesh} k = {k}, {}, {map}, {batch} maps per batch: ",
             backend.name()
         );
-        for _ in 0..WARM_UP_RUNS {
-            engine.ambient(&case.scene, &sphere)?;
+        for run in 0..WARM_UP_RUNS {
+            engine.ambient(scenes[run % 2], &sphere)?;
         }
         let (mut wall, mut host) = (Vec::new(), Vec::new());
-        for _ in 0..runs {
+        for run in 0..runs {
             let cpu_before = thread_cpu_ns();
             let start = Instant::now();
-            let ambient = engine.ambient(&case.scene, &sphere)?;
+            let ambient = engine.ambient(scenes[(WARM_UP_RUNS + run) % 2], &sphere)?;
             wall.push(start.elapsed().as_secs_f64() * 1e3);
             if let (Some(a), Some(b)) = (cpu_before, thread_cpu_ns()) {
                 host.push(b.saturating_sub(a) as f64 * 1e-6);
@@ -281,7 +288,9 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
          Adapter: {adapter}. `cpu` (exact, BVH build + trace) on the same machine's {threads} \
          threads. Each GPU time is the median of {runs} calls of `ambient` after \
          {WARM_UP_RUNS} warm-up calls on one engine: scene upload (and for `rays` the BVH \
-         build), every depth map or ray, the read-back of a_i. Host CPU: what the calling \
+         build: its calls alternate between the scene and a copy 1 + 2⁻²⁰ times larger, \
+         refits off, so that none reuses the last tree), every depth map or ray, the \
+         read-back of a_i. Host CPU: what the calling \
          thread spent per call (building, recording and submitting). Cells ≠ exact: the share \
          of M's cells decided differently from the `cpu` backend's ray cast.\n\n{table}\n\
          Written by `cargo xtask bench visibility-gpu{}{}`.\n",
@@ -294,4 +303,18 @@ pub fn run(repro: &Path, quick: bool, runs: usize, only: Option<&str>) -> anyhow
         .with_context(|| format!("writing {}", path.display()))?;
     eprintln!("wrote {}", path.display());
     Ok(())
+}
+
+/// `scene` with every position 1 + 2⁻²⁰ times farther from the origin: another geometry for
+/// the `rays` backend's tree cache (so a call on it builds a tree), the same work to trace.
+fn rebuilt_twin(scene: &occlusion_gpu::Scene) -> occlusion_gpu::Scene {
+    let mut twin = scene.clone();
+    for index in 0..twin.objects().len() {
+        if let Some(object) = twin.object_mut(index) {
+            for p in &mut object.positions {
+                *p *= 1.0 + f32::EPSILON * 8.0;
+            }
+        }
+    }
+    twin
 }

@@ -6,7 +6,7 @@ use lightsphere::Lightsphere;
 use crate::cpu::{ColumnsTarget, CpuParams, Tracer, compute_columns};
 use crate::depth_params::DepthParams;
 #[cfg(feature = "gpu")]
-use crate::gpu::{DepthPipelines, DepthRun, GpuVisibility, QueryPipelines, RayPipelines};
+use crate::gpu::{DepthPipelines, DepthRun, GpuVisibility, QueryPipelines, RayPipelines, RayTree};
 use crate::progress::{ProgressFn, Ticker};
 use crate::scene::Prepared;
 use crate::{OcclusionError, Scene, VisibilityMatrix};
@@ -43,10 +43,10 @@ impl Backend {
     }
 }
 
-/// How the `cpu` backend's BVH was brought to the last scene it traced.
+/// How the `cpu` or `rays` backend's BVH was brought to the last scene it traced.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum BvhUpdate {
-    /// Nothing traced yet, or a GPU backend.
+    /// Nothing traced yet, or a depth-map backend (`depth`, `query`).
     None,
     /// The geometry had not changed: the tree was reused as it was.
     Reused,
@@ -63,7 +63,8 @@ pub enum BvhUpdate {
     Built,
 }
 
-/// What the last `cpu` computation spent on its BVH.
+/// What the last `cpu` or `rays` computation spent on its BVH (for `rays`: on the CPU,
+/// upload included).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BvhStats {
     /// How the tree was obtained.
@@ -103,9 +104,10 @@ struct Gpu {
     queue: wgpu::Queue,
 }
 
-/// What each backend keeps between calls: the `cpu` backend's BVH of the last scene (reused
-/// while the geometry is unchanged: refinement, vertex filtering on a static mesh, an idle
-/// scene), the GPU backends' device and pipelines (built on first use).
+/// What each backend keeps between calls: the `cpu` and `rays` backends' BVH of the last
+/// scene (reused while the geometry is unchanged: refinement, vertex filtering on a static
+/// mesh, an idle scene; refitted when only positions moved), the GPU backends' device and
+/// pipelines (built on first use).
 enum State {
     Cpu {
         tracer: Option<Tracer>,
@@ -125,6 +127,7 @@ enum State {
     Rays {
         gpu: Gpu,
         pipelines: Option<RayPipelines>,
+        tree: Option<RayTree>,
     },
 }
 
@@ -215,6 +218,7 @@ impl VisibilityEngine {
             Backend::Rays => State::Rays {
                 gpu,
                 pipelines: None,
+                tree: None,
             },
         };
         Self {
@@ -279,8 +283,8 @@ impl VisibilityEngine {
         Ticker::new((rows * columns) as u64, self.progress.clone())
     }
 
-    /// How the last `cpu` computation obtained its BVH (reused, refitted, built) and the time
-    /// it took; [`BvhUpdate::None`] on GPU backends.
+    /// How the last `cpu` or `rays` computation obtained its BVH (reused, refitted, built)
+    /// and the time it took; [`BvhUpdate::None`] on the depth-map backends.
     pub fn last_bvh(&self) -> BvhStats {
         self.last_bvh
     }
@@ -466,7 +470,10 @@ impl VisibilityEngine {
             prepared.receivers.len(),
             directions.len().saturating_sub(first),
         ));
-        match &mut self.state {
+        let Self {
+            state, last_bvh, ..
+        } = self;
+        match state {
             State::Cpu { .. } => Err(OcclusionError::NoDevice {
                 backend: Backend::Cpu.name(),
             }),
@@ -504,9 +511,13 @@ impl VisibilityEngine {
                 )?;
                 Ok((gpu, run))
             }
-            State::Rays { gpu, pipelines } => {
+            State::Rays {
+                gpu,
+                pipelines,
+                tree,
+            } => {
                 let rays = pipelines.get_or_insert_with(|| RayPipelines::new(&gpu.device));
-                let run = rays.run(
+                let (run, stats) = rays.run(
                     &gpu.device,
                     &gpu.queue,
                     prepared,
@@ -514,8 +525,10 @@ impl VisibilityEngine {
                     solid_angles,
                     first,
                     &cpu_params,
+                    tree,
                     &ticker,
                 )?;
+                *last_bvh = stats;
                 Ok((gpu, run))
             }
         }

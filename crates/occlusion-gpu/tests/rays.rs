@@ -10,7 +10,7 @@ use glam::Vec3;
 use gpu_context::GpuContext;
 use lightsphere::Lightsphere;
 use occlusion_gpu::{
-    Backend, CpuMethod, CpuParams, RayCaster, Scene, VisibilityEngine, VisibilityMatrix,
+    Backend, BvhUpdate, CpuMethod, CpuParams, RayCaster, Scene, VisibilityEngine, VisibilityMatrix,
     VisibilityParams,
 };
 
@@ -139,4 +139,115 @@ fn refine_and_progress_agree_with_a_direct_computation() {
     let mut refined = engine.compute(&scene, &coarse).unwrap();
     engine.refine(&scene, &mut refined, &fine).unwrap();
     assert_eq!(direct, refined);
+}
+
+/// A mesh: positions and triangles.
+type Mesh = (Vec<Vec3>, Vec<[u32; 3]>);
+
+/// The synthetic drape over its ball, `frames` frames: positions per frame, the cloth's
+/// triangles, the ball (an occluder only).
+fn drape(frames: usize) -> (Vec<Vec<Vec3>>, Vec<[u32; 3]>, Mesh) {
+    let params = synth::ClothParams {
+        grid: 16,
+        frames,
+        ..Default::default()
+    };
+    let cloth = synth::simulate_cloth(&params).unwrap();
+    let ball = synth::obstacle_mesh(&params.obstacle, 1);
+    (cloth.frames, cloth.triangles, ball)
+}
+
+fn drape_scene(positions: &[Vec3], triangles: &[[u32; 3]], (ball, ball_triangles): &Mesh) -> Scene {
+    let normals = meshio::compute_normals(positions, triangles, meshio::NormalWeighting::Angle);
+    let mut scene = Scene::new();
+    scene
+        .push(occlusion_gpu::SceneObject::new(
+            positions.to_vec(),
+            normals,
+            triangles.to_vec(),
+        ))
+        .unwrap();
+    scene
+        .push(
+            occlusion_gpu::SceneObject::new(
+                ball.clone(),
+                vec![Vec3::Y; ball.len()],
+                ball_triangles.clone(),
+            )
+            .occluder_only(),
+        )
+        .unwrap();
+    scene
+}
+
+/// The rays backend keeps its tree between calls: every frame of a deforming drape (and the
+/// drape grown across the tracer's power-of-two scale) gives, on a refitted tree, the bits of
+/// a tree built for that frame; the same scene again reuses the tree, refinement and vertex
+/// filtering too; another topology rebuilds it.
+#[test]
+fn a_kept_tree_gives_every_frame_the_m_of_a_fresh_one() {
+    let Some(ctx) = gpu() else { return };
+    let (frames, triangles, ball) = drape(24);
+    let sphere = Lightsphere::new(1).unwrap();
+    let mut refitting = rays(&ctx, VisibilityParams::default());
+    let rebuild = CpuParams::default().with_refit(false);
+    let mut rebuilding = rays(&ctx, VisibilityParams::default().with_cpu(rebuild));
+    let mut refits = 0;
+    for (f, positions) in frames.iter().enumerate().step_by(3) {
+        let scene = drape_scene(positions, &triangles, &ball);
+        let a = refitting.compute(&scene, &sphere).unwrap();
+        let b = rebuilding.compute(&scene, &sphere).unwrap();
+        assert_eq!(a.bits(), b.bits(), "frame {f}");
+        assert!(a.visible_count() > 0 && a.visible_count() < a.rows() * sphere.len());
+        assert_eq!(rebuilding.last_bvh().update, BvhUpdate::Built, "frame {f}");
+        match refitting.last_bvh().update {
+            BvhUpdate::Refitted { sah_ratio } => {
+                refits += 1;
+                assert!(sah_ratio > 0.0 && sah_ratio <= occlusion_gpu::REBUILD_SAH_RATIO);
+            }
+            // The first frame, or a tree degraded past the SAH cap.
+            BvhUpdate::Built => {}
+            other => panic!("frame {f}: {other:?}"),
+        }
+    }
+    eprintln!("{refits} of 8 frames refitted");
+    assert!(refits >= 4, "only {refits} refits in 8 frames");
+    let last = frames.last().unwrap();
+    for grow in [3.0f32, 0.2] {
+        let grown = |mesh: &[Vec3]| mesh.iter().map(|p| *p * grow).collect::<Vec<_>>();
+        let scene = drape_scene(&grown(last), &triangles, &(grown(&ball.0), ball.1.clone()));
+        let a = refitting.compute(&scene, &sphere).unwrap();
+        let b = rebuilding.compute(&scene, &sphere).unwrap();
+        assert_eq!(a.bits(), b.bits(), "grown {grow}");
+        assert!(
+            matches!(refitting.last_bvh().update, BvhUpdate::Refitted { .. }),
+            "grown {grow}: {:?}",
+            refitting.last_bvh().update
+        );
+    }
+    // The same scene: reused, for a whole matrix, a refinement and a subset of rows.
+    let scene = drape_scene(last, &triangles, &ball);
+    let mut matrix = refitting.compute(&scene, &sphere).unwrap();
+    refitting.compute(&scene, &sphere).unwrap();
+    assert_eq!(refitting.last_bvh().update, BvhUpdate::Reused);
+    let finer = Lightsphere::new(2).unwrap();
+    refitting.refine(&scene, &mut matrix, &finer).unwrap();
+    assert_eq!(refitting.last_bvh().update, BvhUpdate::Reused);
+    assert_eq!(matrix, rebuilding.compute(&scene, &finer).unwrap());
+    let rows: Vec<u32> = (0..matrix.rows() as u32).step_by(7).collect();
+    let mut filtered = matrix.clone();
+    refitting
+        .compute_rows(&scene, &mut filtered, &rows)
+        .unwrap();
+    assert_eq!(refitting.last_bvh().update, BvhUpdate::Reused);
+    assert_eq!(filtered, matrix);
+    // Another topology: built afresh, and right.
+    let fewer = &triangles[..triangles.len() - 2];
+    let scene = drape_scene(last, fewer, &ball);
+    let a = refitting.compute(&scene, &sphere).unwrap();
+    assert_eq!(refitting.last_bvh().update, BvhUpdate::Built);
+    assert_eq!(
+        a.bits(),
+        rebuilding.compute(&scene, &sphere).unwrap().bits()
+    );
 }

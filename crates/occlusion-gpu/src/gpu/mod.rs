@@ -38,7 +38,7 @@ use wgpu::util::DeviceExt;
 
 pub(crate) use light::LightBox;
 pub(crate) use query::QueryPipelines;
-pub(crate) use rays::RayPipelines;
+pub(crate) use rays::{RayPipelines, RayTree};
 pub use resident::GpuVisibility;
 
 pub(crate) use crate::depth_params::DepthParams;

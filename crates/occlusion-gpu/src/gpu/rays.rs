@@ -6,6 +6,14 @@
 //! tolerance. M equals the `cpu` backend's up to rays within rounding of a triangle edge or of
 //! the tangent plane (the GPU may fuse a multiply and an add where the CPU rounds twice).
 //!
+//! The tree is kept between calls ([`RayTree`]), on the CPU and uploaded: reused as it is while
+//! the geometry is unchanged (refinement to a finer level, vertex filtering, an idle scene),
+//! refitted when only positions moved (a deforming mesh: [`CpuParams::refit`], up to
+//! [`REBUILD_SAH_RATIO`] — the `cpu` backend's clock-based rule is not applied, the GPU's
+//! traversal time not being measured per call), rebuilt otherwise. A refitted tree gives the
+//! same M bit for bit: its boxes still hold their padded triangles and each ray's triangle
+//! tests are the same.
+//!
 //! For GPUs that rasterise on a small part of their chip — a data-centre H100 took 0.4 ms per
 //! 1024² depth map of the bunny — and for anyone who wants the exact answer from a GPU.
 
@@ -14,13 +22,15 @@ use gpu_context::layout::{self, binding};
 use gpu_context::pipeline;
 use wgpu::util::DeviceExt;
 
+use obvhs::bvh2::node::Bvh2Node;
+
 use super::{DepthRun, workgroups};
-use crate::OcclusionError;
 use crate::cpu::{CpuParams, fan_build};
 use crate::matrix::WORD_BITS;
 use crate::progress::Ticker;
-use crate::refit::padded_bvh2;
+use crate::refit::{LeafOrder, REBUILD_SAH_RATIO, padded_bvh2, refit_tree};
 use crate::scene::{Prepared, scaled_max_t};
+use crate::{BvhStats, BvhUpdate, OcclusionError};
 
 const RAYS_SHADER: &str = include_str!("occlusion_rays.wgsl");
 
@@ -57,6 +67,179 @@ struct GpuNode {
     first: u32,
     hi: [f32; 3],
     count: u32,
+}
+
+/// A triangle as the shader reads it: v0, e1 = v1 − v0, e2 = v2 − v0 (each padded to four
+/// floats), computed as the `cpu` backend's single-ray test computes them.
+fn gpu_triangle([v0, v1, v2]: [Vec3A; 3]) -> [f32; 12] {
+    let (e1, e2) = (v1 - v0, v2 - v0);
+    [
+        v0.x, v0.y, v0.z, 0.0, e1.x, e1.y, e1.z, 0.0, e2.x, e2.y, e2.z, 0.0,
+    ]
+}
+
+/// The shader's copy of `nodes`.
+fn gpu_nodes(nodes: &[Bvh2Node]) -> Vec<GpuNode> {
+    nodes
+        .iter()
+        .map(|n| GpuNode {
+            lo: n.aabb.min.into(),
+            first: n.first_index,
+            hi: n.aabb.max.into(),
+            count: n.prim_count,
+        })
+        .collect()
+}
+
+/// The BVH of the last scene the `rays` backend traced: the tree in the tracer's scaled
+/// coordinates (for refits), its leaf order, and its GPU buffers.
+pub(crate) struct RayTree {
+    /// The geometry it was built or refitted for (centred, unscaled).
+    positions: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    /// In the coordinates of that geometry's [`Prepared::tracer_scale`].
+    nodes: Vec<Bvh2Node>,
+    leaves: LeafOrder,
+    /// The leaf-ordered triangles as uploaded.
+    gpu_triangles: Vec<[f32; 12]>,
+    node_buffer: wgpu::Buffer,
+    triangle_buffer: wgpu::Buffer,
+}
+
+impl RayTree {
+    /// Builds the tree of `prepared` (at its tracer scale) and uploads it.
+    fn build(device: &wgpu::Device, prepared: &Prepared) -> Result<Self, OcclusionError> {
+        let scaled = prepared.scaled(prepared.tracer_scale());
+        let (nodes, triangles, leaves) = padded_bvh2(&scaled, fan_build(), LEAF_SIZE);
+        let depth = tree_depth(&nodes);
+        if depth > STACK_SIZE {
+            return Err(OcclusionError::BvhTooDeep {
+                depth: depth as u64,
+                maximum: STACK_SIZE as u64,
+            });
+        }
+        let gpu_triangles: Vec<[f32; 12]> = triangles
+            .iter()
+            .map(|t| gpu_triangle([t.v0, t.v1, t.v2]))
+            .collect();
+        let max_binding = device.limits().max_storage_buffer_binding_size;
+        for (what, value) in [
+            ("rays backend BVH node bytes", (nodes.len() * 32) as u64),
+            ("rays backend triangle bytes", (triangles.len() * 48) as u64),
+        ] {
+            if value > max_binding {
+                return Err(OcclusionError::GpuLimit {
+                    what,
+                    value,
+                    maximum: max_binding,
+                });
+            }
+        }
+        let node_buffer = storage_init(
+            device,
+            "occlusion rays nodes",
+            bytemuck::cast_slice(&gpu_nodes(&nodes)),
+        );
+        let triangle_buffer = storage_init(
+            device,
+            "occlusion rays triangles",
+            bytemuck::cast_slice(&gpu_triangles),
+        );
+        Ok(Self {
+            positions: prepared.positions.clone(),
+            triangles: prepared.triangles.clone(),
+            nodes,
+            leaves,
+            gpu_triangles,
+            node_buffer,
+            triangle_buffer,
+        })
+    }
+
+    /// Whether this tree was built (or refitted) for exactly `prepared`'s geometry.
+    fn fits(&self, prepared: &Prepared) -> bool {
+        self.positions == prepared.positions && self.triangles == prepared.triangles
+    }
+
+    /// Refits the tree to `prepared` when only positions changed (same triangles and vertex
+    /// count; the boxes are recomputed at the new tracer scale, which a growing scene may
+    /// change) and uploads it: the SAH cost over the build's (which does not depend on the
+    /// scale), or `None` when it cannot be refitted.
+    fn refit(&mut self, queue: &wgpu::Queue, prepared: &Prepared) -> Option<f32> {
+        if self.triangles != prepared.triangles
+            || self.positions.len() != prepared.positions.len()
+            || self.nodes.is_empty()
+        {
+            return None;
+        }
+        let scaled = prepared.scaled(prepared.tracer_scale());
+        let ratio = refit_tree(
+            &mut self.nodes,
+            &self.leaves,
+            &mut self.gpu_triangles,
+            &scaled,
+            gpu_triangle,
+        )?;
+        self.positions.clone_from(&prepared.positions);
+        queue.write_buffer(
+            &self.node_buffer,
+            0,
+            bytemuck::cast_slice(&gpu_nodes(&self.nodes)),
+        );
+        queue.write_buffer(
+            &self.triangle_buffer,
+            0,
+            bytemuck::cast_slice(&self.gpu_triangles),
+        );
+        Some(ratio)
+    }
+
+    /// Brings `cached` to `prepared`: reused when it fits, refitted when `refit` allows and
+    /// the refitted tree's SAH ratio is at most [`REBUILD_SAH_RATIO`], built otherwise.
+    pub(crate) fn update<'a>(
+        cached: &'a mut Option<Self>,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        prepared: &Prepared,
+        refit: bool,
+    ) -> Result<(&'a Self, BvhStats), OcclusionError> {
+        let start = std::time::Instant::now();
+        let update = match cached.as_mut() {
+            Some(tree) if tree.fits(prepared) => BvhUpdate::Reused,
+            Some(tree) if refit => match tree.refit(queue, prepared) {
+                Some(sah_ratio) if sah_ratio <= REBUILD_SAH_RATIO => {
+                    BvhUpdate::Refitted { sah_ratio }
+                }
+                _ => BvhUpdate::Built,
+            },
+            _ => BvhUpdate::Built,
+        };
+        if update == BvhUpdate::Built {
+            // The old tree goes first: a failed build leaves nothing stale behind.
+            *cached = None;
+            *cached = Some(Self::build(device, prepared)?);
+        }
+        let stats = BvhStats {
+            update,
+            millis: start.elapsed().as_secs_f64() * 1e3,
+        };
+        Ok((cached.as_ref().expect("set above"), stats))
+    }
+}
+
+/// A storage buffer holding `contents` (one zero triangle's worth when empty: wgpu refuses a
+/// zero-sized binding), writable by `queue.write_buffer` for refits.
+fn storage_init(device: &wgpu::Device, label: &str, contents: &[u8]) -> wgpu::Buffer {
+    let contents = if contents.is_empty() {
+        &[0u8; 48][..]
+    } else {
+        contents
+    };
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+    })
 }
 
 /// The compiled pipelines of the `rays` backend (built once per device).
@@ -108,7 +291,8 @@ impl RayPipelines {
         }
     }
 
-    /// Computes the columns `first..k` on the GPU; the results stay in the returned buffers.
+    /// Computes the columns `first..k` on the GPU with `tree` brought to `prepared`
+    /// ([`RayTree::update`]); the results stay in the returned buffers.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn run(
         &self,
@@ -119,8 +303,9 @@ impl RayPipelines {
         solid_angles: &[f64],
         first: usize,
         params: &CpuParams,
+        tree: &mut Option<RayTree>,
         ticker: &std::sync::Arc<Ticker>,
-    ) -> Result<DepthRun, OcclusionError> {
+    ) -> Result<(DepthRun, BvhStats), OcclusionError> {
         let k = directions.len();
         let rows = prepared.receivers.len();
         let words_per_row = k.div_ceil(WORD_BITS);
@@ -139,46 +324,12 @@ impl RayPipelines {
                 [o.x, o.y, o.z, 1.0, n.x, n.y, n.z, 0.0]
             })
             .collect();
-        let scaled = prepared.scaled(scale);
-        let (nodes, triangles, _) = padded_bvh2(&scaled, fan_build(), LEAF_SIZE);
-        let depth = tree_depth(&nodes);
-        if depth > STACK_SIZE {
-            return Err(OcclusionError::BvhTooDeep {
-                depth: depth as u64,
-                maximum: STACK_SIZE as u64,
-            });
-        }
-        let gpu_nodes: Vec<GpuNode> = nodes
-            .iter()
-            .map(|n| GpuNode {
-                lo: n.aabb.min.into(),
-                first: n.first_index,
-                hi: n.aabb.max.into(),
-                count: n.prim_count,
-            })
-            .collect();
-        let gpu_triangles: Vec<[f32; 12]> = triangles
-            .iter()
-            .map(|t| {
-                let (e1, e2) = (t.v1 - t.v0, t.v2 - t.v0);
-                [
-                    t.v0.x, t.v0.y, t.v0.z, 0.0, e1.x, e1.y, e1.z, 0.0, e2.x, e2.y, e2.z, 0.0,
-                ]
-            })
-            .collect();
-        let dirs: Vec<[f32; 4]> = directions
-            .iter()
-            .zip(solid_angles)
-            .map(|(d, w)| [d.x, d.y, d.z, (w / std::f64::consts::PI) as f32])
-            .collect();
         let max_binding = device.limits().max_storage_buffer_binding_size;
         let bits_bytes = (rows * words_per_row * 4) as u64;
         let shares_bytes = (rows * call_word_count * 4) as u64;
         for (what, value) in [
             ("visibility bits buffer bytes", bits_bytes),
             ("rays backend a_i shares bytes", shares_bytes),
-            ("rays backend BVH node bytes", (nodes.len() * 32) as u64),
-            ("rays backend triangle bytes", (triangles.len() * 48) as u64),
         ] {
             if value > max_binding {
                 return Err(OcclusionError::GpuLimit {
@@ -188,26 +339,22 @@ impl RayPipelines {
                 });
             }
         }
+        let (tree, stats) = RayTree::update(tree, device, queue, prepared, params.refit)?;
+        let dirs: Vec<[f32; 4]> = directions
+            .iter()
+            .zip(solid_angles)
+            .map(|(d, w)| [d.x, d.y, d.z, (w / std::f64::consts::PI) as f32])
+            .collect();
         let storage = wgpu::BufferUsages::STORAGE;
-        let init = |label, contents: &[u8]| {
-            // wgpu refuses a zero-sized binding: an empty list uploads one zero word.
-            let contents = if contents.is_empty() {
-                &[0u8; 48][..]
-            } else {
-                contents
-            };
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage: storage,
-            })
-        };
-        let origin_buffer = init("occlusion rays origins", bytemuck::cast_slice(&origins));
-        let direction_buffer = init("occlusion rays directions", bytemuck::cast_slice(&dirs));
-        let node_buffer = init("occlusion rays nodes", bytemuck::cast_slice(&gpu_nodes));
-        let triangle_buffer = init(
-            "occlusion rays triangles",
-            bytemuck::cast_slice(&gpu_triangles),
+        let origin_buffer = storage_init(
+            device,
+            "occlusion rays origins",
+            bytemuck::cast_slice(&origins),
+        );
+        let direction_buffer = storage_init(
+            device,
+            "occlusion rays directions",
+            bytemuck::cast_slice(&dirs),
         );
         let zeroed = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -236,8 +383,8 @@ impl RayPipelines {
                 params_buffer.as_entire_binding(),
                 origin_buffer.as_entire_binding(),
                 direction_buffer.as_entire_binding(),
-                node_buffer.as_entire_binding(),
-                triangle_buffer.as_entire_binding(),
+                tree.node_buffer.as_entire_binding(),
+                tree.triangle_buffer.as_entire_binding(),
                 bits.as_entire_binding(),
                 shares.as_entire_binding(),
                 ambient.as_entire_binding(),
@@ -251,7 +398,7 @@ impl RayPipelines {
             first_direction: first as u32,
             k: k as u32,
             max_t: scaled_max_t(params.max_distance, scale).min(f32::MAX),
-            node_count: gpu_nodes.len() as u32,
+            node_count: tree.nodes.len() as u32,
             call_first_word: call_first_word as u32,
             call_word_count: call_word_count as u32,
             _pad: [0; 2],
@@ -296,7 +443,7 @@ impl RayPipelines {
         }
         queue.write_buffer(&params_buffer, 0, bytemuck::bytes_of(&base));
         dispatch(&self.sum_rows, "occlusion rays: a_i", rows);
-        Ok(DepthRun {
+        let run = DepthRun {
             bits,
             ambient,
             rows,
@@ -306,7 +453,8 @@ impl RayPipelines {
                 .iter()
                 .map(|r| r.normal == Vec3::ZERO)
                 .collect(),
-        })
+        };
+        Ok((run, stats))
     }
 }
 
