@@ -759,7 +759,7 @@ fn scatter_chunks(
 
 /// The receiver rows sorted by the Morton code of their positions (10 bits per axis over the
 /// scene's bounding cube), so consecutive rows are spatial neighbours.
-fn morton_order(prepared: &Prepared) -> Vec<u32> {
+pub(crate) fn morton_order(prepared: &Prepared) -> Vec<u32> {
     let scale = if prepared.radius > 0.0 {
         1023.0 / (2.0 * prepared.radius)
     } else {

