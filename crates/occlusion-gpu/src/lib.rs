@@ -55,7 +55,7 @@
 //!   `cpu`'s up to rays within rounding of an edge or the tangent plane (the full bunny at
 //!   k = 258: identical, M's hash; 2 grazing rays of the sphere over a plane's 285,606), and
 //!   [`CpuParams::max_distance`] applies. The tree is kept between calls, as `cpu`'s is.
-//!   For GPUs that rasterise slowly; not yet timed on one (lavapipe: 3.6 s for the bunny at
+//!   For GPUs that rasterise slowly; not yet timed on one (lavapipe: 3.1 s for the bunny at
 //!   k = 258, compute emulated on the CPU).
 //!
 //! Which backend is fastest depends on the machine. On an NVIDIA H100 (Vulkan, driver
