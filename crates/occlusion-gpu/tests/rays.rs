@@ -141,45 +141,6 @@ fn refine_and_progress_agree_with_a_direct_computation() {
     assert_eq!(direct, refined);
 }
 
-/// A mesh: positions and triangles.
-type Mesh = (Vec<Vec3>, Vec<[u32; 3]>);
-
-/// The synthetic drape over its ball, `frames` frames: positions per frame, the cloth's
-/// triangles, the ball (an occluder only).
-fn drape(frames: usize) -> (Vec<Vec<Vec3>>, Vec<[u32; 3]>, Mesh) {
-    let params = synth::ClothParams {
-        grid: 16,
-        frames,
-        ..Default::default()
-    };
-    let cloth = synth::simulate_cloth(&params).unwrap();
-    let ball = synth::obstacle_mesh(&params.obstacle, 1);
-    (cloth.frames, cloth.triangles, ball)
-}
-
-fn drape_scene(positions: &[Vec3], triangles: &[[u32; 3]], (ball, ball_triangles): &Mesh) -> Scene {
-    let normals = meshio::compute_normals(positions, triangles, meshio::NormalWeighting::Angle);
-    let mut scene = Scene::new();
-    scene
-        .push(occlusion_gpu::SceneObject::new(
-            positions.to_vec(),
-            normals,
-            triangles.to_vec(),
-        ))
-        .unwrap();
-    scene
-        .push(
-            occlusion_gpu::SceneObject::new(
-                ball.clone(),
-                vec![Vec3::Y; ball.len()],
-                ball_triangles.clone(),
-            )
-            .occluder_only(),
-        )
-        .unwrap();
-    scene
-}
-
 /// The rays backend keeps its tree between calls: every frame of a deforming drape (and the
 /// drape grown across the tracer's power-of-two scale) gives, on a refitted tree, the bits of
 /// a tree built for that frame; the same scene again reuses the tree, refinement and vertex
@@ -187,29 +148,13 @@ fn drape_scene(positions: &[Vec3], triangles: &[[u32; 3]], (ball, ball_triangles
 #[test]
 fn a_kept_tree_gives_every_frame_the_m_of_a_fresh_one() {
     let Some(ctx) = gpu() else { return };
-    let (frames, triangles, ball) = drape(24);
+    let drape = drape_frames(16, 24, 1);
     let sphere = Lightsphere::new(1).unwrap();
     let mut refitting = rays(&ctx, VisibilityParams::default());
     let rebuild = CpuParams::default().with_refit(false);
     let mut rebuilding = rays(&ctx, VisibilityParams::default().with_cpu(rebuild));
-    let mut refits = 0;
-    for (f, positions) in frames.iter().enumerate().step_by(3) {
-        let scene = drape_scene(positions, &triangles, &ball);
-        let a = refitting.compute(&scene, &sphere).unwrap();
-        let b = rebuilding.compute(&scene, &sphere).unwrap();
-        assert_eq!(a.bits(), b.bits(), "frame {f}");
-        assert!(a.visible_count() > 0 && a.visible_count() < a.rows() * sphere.len());
-        assert_eq!(rebuilding.last_bvh().update, BvhUpdate::Built, "frame {f}");
-        match refitting.last_bvh().update {
-            BvhUpdate::Refitted { sah_ratio } => {
-                refits += 1;
-                assert!(sah_ratio > 0.0 && sah_ratio <= occlusion_gpu::REBUILD_SAH_RATIO);
-            }
-            // The first frame, or a tree degraded past the SAH cap.
-            BvhUpdate::Built => {}
-            other => panic!("frame {f}: {other:?}"),
-        }
-    }
+    let refits = refits_over_frames(&mut refitting, &mut rebuilding, &drape, &sphere, "rays");
+    let (frames, triangles, ball) = drape;
     eprintln!("{refits} of 8 frames refitted");
     assert!(refits >= 4, "only {refits} refits in 8 frames");
     let last = frames.last().unwrap();

@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 
 use glam::{DVec3, Vec3};
 use lightsphere::Lightsphere;
-use occlusion_gpu::{Scene, SceneObject};
+use occlusion_gpu::{BvhUpdate, Scene, SceneObject, VisibilityEngine};
 
 /// A triangle mesh with per-vertex normals.
 pub struct TestMesh {
@@ -179,4 +179,91 @@ pub fn assert_close(actual: f64, expected: f64, tolerance: f64, what: &str) {
         "{what}: {actual} vs expected {expected} (|Δ| = {:.3e} > tolerance {tolerance:.3e})",
         (actual - expected).abs()
     );
+}
+
+/// A mesh: positions and triangles.
+pub type Mesh = (Vec<Vec3>, Vec<[u32; 3]>);
+
+/// The synthetic drape (a `grid` × `grid` cloth falling over its ball), `frames` frames:
+/// positions per frame, the cloth's triangles, and the ball subdivided `ball_level` times.
+pub fn drape_frames(
+    grid: usize,
+    frames: usize,
+    ball_level: u32,
+) -> (Vec<Vec<Vec3>>, Vec<[u32; 3]>, Mesh) {
+    let params = synth::ClothParams {
+        grid,
+        frames,
+        ..Default::default()
+    };
+    let cloth = synth::simulate_cloth(&params).unwrap();
+    let ball = synth::obstacle_mesh(&params.obstacle, ball_level);
+    (cloth.frames, cloth.triangles, ball)
+}
+
+/// One drape frame over its ball (an occluder only), normals computed from the frame.
+pub fn drape_scene(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    (ball, ball_triangles): &Mesh,
+) -> Scene {
+    let normals = meshio::compute_normals(positions, triangles, meshio::NormalWeighting::Angle);
+    let mut scene = Scene::new();
+    scene
+        .push(SceneObject::new(
+            positions.to_vec(),
+            normals,
+            triangles.to_vec(),
+        ))
+        .unwrap();
+    scene
+        .push(
+            SceneObject::new(
+                ball.clone(),
+                vec![Vec3::Y; ball.len()],
+                ball_triangles.clone(),
+            )
+            .occluder_only(),
+        )
+        .unwrap();
+    scene
+}
+
+/// Every third of `frames` through both engines: the same bits on every frame, some sky and
+/// some shadow, `rebuilding` building each time and `refitting` refitting within
+/// [`occlusion_gpu::REBUILD_SAH_RATIO`] (or building: the first frame, a degraded tree).
+/// Returns the number of refits; `what` names the case in messages.
+pub fn refits_over_frames(
+    refitting: &mut VisibilityEngine,
+    rebuilding: &mut VisibilityEngine,
+    (frames, triangles, ball): &(Vec<Vec<Vec3>>, Vec<[u32; 3]>, Mesh),
+    sphere: &Lightsphere,
+    what: &str,
+) -> usize {
+    let mut refits = 0;
+    for (f, positions) in frames.iter().enumerate().step_by(3) {
+        let scene = drape_scene(positions, triangles, ball);
+        let a = refitting.compute(&scene, sphere).unwrap();
+        let b = rebuilding.compute(&scene, sphere).unwrap();
+        assert_eq!(a.bits(), b.bits(), "{what} frame {f}");
+        let open = a.visible_count();
+        assert!(
+            open > 0 && open < a.rows() * sphere.len(),
+            "{what} frame {f}"
+        );
+        assert_eq!(
+            rebuilding.last_bvh().update,
+            BvhUpdate::Built,
+            "{what} frame {f}"
+        );
+        match refitting.last_bvh().update {
+            BvhUpdate::Refitted { sah_ratio } => {
+                refits += 1;
+                assert!(sah_ratio > 0.0 && sah_ratio <= occlusion_gpu::REBUILD_SAH_RATIO);
+            }
+            BvhUpdate::Built => {}
+            other => panic!("{what} frame {f}: {other:?}"),
+        }
+    }
+    refits
 }
