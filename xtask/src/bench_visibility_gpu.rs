@@ -3,16 +3,15 @@
 //! k = 1026 in ≤ 5 ms, depth passes included) and the exact `rays` — beside the `cpu` backend
 //! on the same machine.
 //!
-//! Per case: the median and the fastest of `--runs` calls of [`VisibilityEngine::ambient`]
-//! on one engine (pipelines built once; each call uploads the scene, renders every depth map
-//! or builds and uploads the BVH, tests every vertex and reads a_i back, as a deforming frame
-//! pays — `rays` keeps its tree for an unchanged scene, so its calls alternate between the
-//! scene and a copy 1 + 2⁻²⁰ times larger, with refitting off), after three warm-up calls; the CPU time the calling thread spent per call
-//! (recording, submission, driver, and `rays`' BVH build: when it is close to the wall time
-//! the host is the limit, not the GPU); and what the speed costs in accuracy: the share of
-//! M's cells that differ from the `cpu` backend's exact M, and max |Δa_i|. The `cpu`
-//! backend's time (BVH build + trace, all threads) is measured on the same machine for the
-//! ratio.
+//! Per case: the median and the fastest of `--runs` calls of [`VisibilityEngine::ambient`] on one
+//! engine (pipelines built once; each call uploads the scene, renders every depth map or builds and
+//! uploads the BVH, tests every vertex and reads a_i back, as a deforming frame pays — `rays` keeps
+//! its tree for an unchanged scene, so its calls alternate between the scene and a copy 1 + 2⁻²⁰
+//! times larger, with refitting off), after three warm-up calls; the CPU time the calling thread
+//! spent per call (recording, submission, driver, and `rays`' BVH build: when it is close to the
+//! wall time the host is the limit, not the GPU); and what the speed costs in accuracy: the share
+//! of M's cells that differ from the `cpu` backend's exact M, and max |Δa_i|. The `cpu` backend's
+//! time (BVH build + trace, all threads) is measured on the same machine for the ratio.
 //!
 //! Cases: `depth` on the bunny at k = 6 … 1026 (depth maps of 1024²), the bunny at
 //! k = 1026 at 256² … 2048² and with batches of 16 and 256 layers, the dragon and igea at

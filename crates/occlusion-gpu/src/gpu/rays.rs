@@ -1,11 +1,12 @@
 //! The `rays` backend: the `cpu` backend's exact rays cast by a compute shader
-//! (`occlusion_rays.wgsl`) — no depth map, no bias, no resolution. The binary BVH is built on
-//! the CPU (`obvhs`'s PLOC, boxes padded as for the fans), the ray origins too (so that they
-//! round as the CPU's), and the GPU walks it: one invocation per (receiver row, 32-direction
-//! word of M), neighbouring invocations on rows neighbouring in Morton order (coherent walks:
-//! 1.17–1.19× faster on lavapipe than file order on the bunny at k = 66 and 258), any hit, the CPU single-ray test's Möller–Trumbore arithmetic and edge
-//! tolerance. M equals the `cpu` backend's up to rays within rounding of a triangle edge or of
-//! the tangent plane (the GPU may fuse a multiply and an add where the CPU rounds twice).
+//! (`occlusion_rays.wgsl`) — no depth map, no bias, no resolution. The binary BVH is built on the
+//! CPU (`obvhs`'s PLOC, boxes padded as for the fans), the ray origins too (so that they round as
+//! the CPU's), and the GPU walks it: one invocation per (receiver row, 32-direction word of M),
+//! neighbouring invocations on rows neighbouring in Morton order (coherent walks: 1.17–1.19× faster
+//! on lavapipe than file order on the bunny at k = 66 and 258), any hit, the CPU single-ray test's
+//! Möller–Trumbore arithmetic and edge tolerance. M equals the `cpu` backend's up to rays within
+//! rounding of a triangle edge or of the tangent plane (the GPU may fuse a multiply and an add
+//! where the CPU rounds twice).
 //!
 //! The tree is kept between calls ([`RayTree`]), on the CPU and uploaded: reused as it is while
 //! the geometry is unchanged (refinement to a finer level, vertex filtering, an idle scene),
