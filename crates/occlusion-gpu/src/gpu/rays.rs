@@ -165,9 +165,10 @@ impl RayTree {
 
     /// Refits the tree to `prepared` when only positions changed (same triangles and vertex
     /// count; the boxes are recomputed at the new tracer scale, which a growing scene may
-    /// change) and uploads it: the SAH cost over the build's (which does not depend on the
-    /// scale), or `None` when it cannot be refitted.
-    fn refit(&mut self, queue: &wgpu::Queue, prepared: &Prepared) -> Option<f32> {
+    /// change): the SAH cost over the build's (which does not depend on the scale), or `None`
+    /// when it cannot be refitted. Nothing is uploaded: [`RayTree::upload`] does that once the
+    /// refit is kept.
+    fn refit(&mut self, prepared: &Prepared) -> Option<f32> {
         if self.triangles != prepared.triangles
             || self.positions.len() != prepared.positions.len()
             || self.nodes.is_empty()
@@ -183,6 +184,11 @@ impl RayTree {
             gpu_triangle,
         )?;
         self.positions.clone_from(&prepared.positions);
+        Some(ratio)
+    }
+
+    /// Writes the (refitted) nodes and triangles into the tree's GPU buffers.
+    fn upload(&self, queue: &wgpu::Queue) {
         queue.write_buffer(
             &self.node_buffer,
             0,
@@ -193,7 +199,6 @@ impl RayTree {
             0,
             bytemuck::cast_slice(&self.gpu_triangles),
         );
-        Some(ratio)
     }
 
     /// Brings `cached` to `prepared`: reused when it fits, refitted when `refit` allows and
@@ -208,8 +213,9 @@ impl RayTree {
         let start = std::time::Instant::now();
         let update = match cached.as_mut() {
             Some(tree) if tree.fits(prepared) => BvhUpdate::Reused,
-            Some(tree) if refit => match tree.refit(queue, prepared) {
+            Some(tree) if refit => match tree.refit(prepared) {
                 Some(sah_ratio) if sah_ratio <= REBUILD_SAH_RATIO => {
+                    tree.upload(queue);
                     BvhUpdate::Refitted { sah_ratio }
                 }
                 _ => BvhUpdate::Built,
