@@ -411,6 +411,23 @@ pub(crate) fn check_resolution(
     Ok(resolution)
 }
 
+/// Refuses any of `sizes` (what, bytes) above the device's storage-binding limit, naming the
+/// first one that is.
+pub(crate) fn check_storage_bindings(
+    device: &wgpu::Device,
+    sizes: &[(&'static str, u64)],
+) -> Result<(), OcclusionError> {
+    let maximum = device.limits().max_storage_buffer_binding_size;
+    match sizes.iter().find(|(_, value)| *value > maximum) {
+        Some(&(what, value)) => Err(OcclusionError::GpuLimit {
+            what,
+            value,
+            maximum,
+        }),
+        None => Ok(()),
+    }
+}
+
 /// The GPU buffers the two depth-map backends share for one computation: lights, receivers, the
 /// scene's geometry, and the zero-initialised outputs (visibility bits, a_i).
 pub(crate) struct SceneBuffers {
@@ -447,14 +464,7 @@ impl SceneBuffers {
         let rows = prepared.receivers.len();
         let words_per_row = k.div_ceil(WORD_BITS);
         let bits_bytes = (rows * words_per_row * 4) as u64;
-        let max_binding = device.limits().max_storage_buffer_binding_size;
-        if bits_bytes > max_binding {
-            return Err(OcclusionError::GpuLimit {
-                what: "visibility bits buffer bytes",
-                value: bits_bytes,
-                maximum: max_binding,
-            });
-        }
+        check_storage_bindings(device, &[("visibility bits buffer bytes", bits_bytes)])?;
         let light_box = LightBox::new(prepared.radius);
         let lights = light_box.lights(directions, solid_angles);
         let receivers: Vec<[f32; 8]> = prepared
@@ -615,5 +625,33 @@ impl DepthRun {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// At the limit passes; one byte over is refused, naming the first buffer over it with
+    /// its size and the device's limit.
+    #[test]
+    fn storage_bindings_past_the_device_limit_are_refused_by_name() {
+        let Some(ctx) = gpu_context::testing::gpu_or_skip() else {
+            return;
+        };
+        let maximum = ctx.device.limits().max_storage_buffer_binding_size;
+        assert!(check_storage_bindings(&ctx.device, &[("a", maximum), ("b", 0)]).is_ok());
+        let refused = check_storage_bindings(
+            &ctx.device,
+            &[("a", maximum), ("b", maximum + 1), ("c", u64::MAX)],
+        );
+        match refused {
+            Err(OcclusionError::GpuLimit {
+                what,
+                value,
+                maximum: limit,
+            }) => assert_eq!((what, value, limit), ("b", maximum + 1, maximum)),
+            other => panic!("{other:?}"),
+        }
     }
 }

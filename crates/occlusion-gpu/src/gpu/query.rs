@@ -22,7 +22,10 @@
 use glam::Vec3;
 use wgpu::{QUERY_SET_MAX_QUERIES, QUERY_SIZE};
 
-use super::{DepthParams, DepthPipelines, DepthRun, SceneBuffers, check_resolution, storage_entry};
+use super::{
+    DepthParams, DepthPipelines, DepthRun, SceneBuffers, check_resolution, check_storage_bindings,
+    storage_entry,
+};
 use crate::OcclusionError;
 use crate::progress::Ticker;
 use crate::scene::Prepared;
@@ -202,14 +205,13 @@ impl QueryPipelines {
         let batch_directions = (DEFAULT_MAX_BATCH_QUERIES / rows).clamp(1, k - first);
         let batch_queries = batch_directions * rows;
         let resolved_bytes = batch_queries as u64 * u64::from(QUERY_SIZE);
-        let max_binding = device.limits().max_storage_buffer_binding_size;
-        if resolved_bytes > max_binding {
-            return Err(OcclusionError::GpuLimit {
-                what: "resolved occlusion-query bytes (receiver vertices × 8)",
-                value: resolved_bytes,
-                maximum: max_binding,
-            });
-        }
+        check_storage_bindings(
+            device,
+            &[(
+                "resolved occlusion-query bytes (receiver vertices × 8)",
+                resolved_bytes,
+            )],
+        )?;
         let set_size = QUERY_SET_MAX_QUERIES as usize;
         let query_sets: Vec<wgpu::QuerySet> = (0..batch_queries.div_ceil(set_size))
             .map(|_| {

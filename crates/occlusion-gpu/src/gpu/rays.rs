@@ -26,7 +26,7 @@ use wgpu::util::DeviceExt;
 
 use obvhs::bvh2::node::Bvh2Node;
 
-use super::{DepthRun, workgroups};
+use super::{DepthRun, check_storage_bindings, workgroups};
 use crate::cpu::{CpuParams, fan_build, morton_order};
 use crate::matrix::WORD_BITS;
 use crate::progress::Ticker;
@@ -124,19 +124,13 @@ impl RayTree {
             .iter()
             .map(|t| gpu_triangle([t.v0, t.v1, t.v2]))
             .collect();
-        let max_binding = device.limits().max_storage_buffer_binding_size;
-        for (what, value) in [
-            ("rays backend BVH node bytes", (nodes.len() * 32) as u64),
-            ("rays backend triangle bytes", (triangles.len() * 48) as u64),
-        ] {
-            if value > max_binding {
-                return Err(OcclusionError::GpuLimit {
-                    what,
-                    value,
-                    maximum: max_binding,
-                });
-            }
-        }
+        check_storage_bindings(
+            device,
+            &[
+                ("rays backend BVH node bytes", (nodes.len() * 32) as u64),
+                ("rays backend triangle bytes", (triangles.len() * 48) as u64),
+            ],
+        )?;
         let node_buffer = storage_init(
             device,
             "occlusion rays nodes",
@@ -337,21 +331,15 @@ impl RayPipelines {
                 [o.x, o.y, o.z, 1.0, n.x, n.y, n.z, 0.0]
             })
             .collect();
-        let max_binding = device.limits().max_storage_buffer_binding_size;
         let bits_bytes = (rows * words_per_row * 4) as u64;
         let shares_bytes = (rows * call_word_count * 4) as u64;
-        for (what, value) in [
-            ("visibility bits buffer bytes", bits_bytes),
-            ("rays backend a_i shares bytes", shares_bytes),
-        ] {
-            if value > max_binding {
-                return Err(OcclusionError::GpuLimit {
-                    what,
-                    value,
-                    maximum: max_binding,
-                });
-            }
-        }
+        check_storage_bindings(
+            device,
+            &[
+                ("visibility bits buffer bytes", bits_bytes),
+                ("rays backend a_i shares bytes", shares_bytes),
+            ],
+        )?;
         let (tree, stats) = RayTree::update(tree, device, queue, prepared, params.refit)?;
         let dirs: Vec<[f32; 4]> = directions
             .iter()
