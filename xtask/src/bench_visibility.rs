@@ -10,15 +10,21 @@
 //! n·l > 0 — and the triangle soup in the engine's centred coordinates are written as `.npy`
 //! under `target/bench-visibility/`; `xtask/scripts/visibility_peers.py` traces them in a
 //! virtual environment under `target/mitsuba-venv` (Mitsuba and Open3D are comparisons, not
-//! dependencies). Ours: a fresh engine per run (BVH build + trace, as a deforming frame pays)
-//! and, on the same engine, the trace alone (the BVH reused). Peers: scene build and trace
-//! apart. Times are medians; the occluded-ray counts are compared as a cross-check. Writes
+//! dependencies), served one trace per request so that each round runs ours and then each peer
+//! within seconds. Ours: a fresh engine per run (BVH build + trace, as a deforming frame pays)
+//! and, on the same engine, the trace alone (the BVH reused). Peers: scene build (once) and
+//! trace apart. Times are medians over the rounds, and each ratio is the median of the rounds'
+//! own ratios: this machine's speed drifts by up to a quarter within minutes (the bunny's trace
+//! at k = 258 took 0.25–0.37 s in one session, the code unchanged), and before the rounds
+//! alternated our runs and the peers' came minutes apart (the ratio moved from 0.72 to 0.83
+//! between two days). The occluded-ray counts are compared as a cross-check. Writes
 //! `target/repro/bench-visibility.md`. Open3D's wheel needs `libusb-1.0-0` (Debian); a peer that
 //! cannot be imported is reported in its column, not fatal.
 
 use std::fmt::Write as _;
+use std::io::{BufRead, BufReader, Write as _};
 use std::path::Path;
-use std::process::Command;
+use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 use std::time::Instant;
 
 use anyhow::{Context, bail};
@@ -32,11 +38,99 @@ pub(crate) struct Case {
     level: u32,
 }
 
-struct Ours {
+/// One of our runs: a fresh engine (BVH build + trace), then the same engine again (the BVH
+/// reused, the trace alone).
+struct OurRun {
     rays: u64,
     occluded: u64,
     full_ms: f64,
     trace_ms: f64,
+}
+
+/// What one peer measured on one case: its build once, a trace per round.
+#[derive(Default)]
+struct PeerRuns {
+    build_ms: f64,
+    trace_ms: Vec<f64>,
+    occluded: u64,
+    error: Option<String>,
+}
+
+/// The peers' script, serving one trace per request (`xtask/scripts/visibility_peers.py`).
+struct PeerServer {
+    child: Child,
+    stdin: ChildStdin,
+    stdout: BufReader<ChildStdout>,
+}
+
+impl PeerServer {
+    fn start(python: &Path, root: &Path, dir: &Path, threads: usize) -> anyhow::Result<Self> {
+        let mut child = Command::new(python)
+            .arg(root.join("xtask/scripts/visibility_peers.py"))
+            .arg(dir)
+            .arg(threads.to_string())
+            .env("DRJIT_LIBLLVM_PATH", llvm_path().unwrap_or_default())
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .context("cannot start the peers' script")?;
+        let stdin = child
+            .stdin
+            .take()
+            .context("the peers' script has no stdin")?;
+        let stdout = BufReader::new(
+            child
+                .stdout
+                .take()
+                .context("the peers' script has no stdout")?,
+        );
+        Ok(Self {
+            child,
+            stdin,
+            stdout,
+        })
+    }
+
+    /// One trace of `peer` on `case` (its scene built on the first request).
+    fn ask(&mut self, case: &str, peer: &str) -> anyhow::Result<serde_json::Value> {
+        writeln!(self.stdin, "{case} {peer}").context("the peers' script stopped reading")?;
+        self.stdin.flush()?;
+        let mut line = String::new();
+        if self.stdout.read_line(&mut line)? == 0 {
+            bail!("the peers' script exited while tracing {case} with {peer}");
+        }
+        serde_json::from_str(&line)
+            .with_context(|| format!("the peers' script answered {line:?} for {case} / {peer}"))
+    }
+
+    /// Records one round of `peer` on `case` in `runs`.
+    fn round(&mut self, case: &str, peer: &str, runs: &mut PeerRuns) -> anyhow::Result<()> {
+        if runs.error.is_some() {
+            return Ok(());
+        }
+        let reply = self.ask(case, peer)?;
+        if let Some(e) = reply.get("error") {
+            runs.error = Some(e.as_str().unwrap_or("error").to_owned());
+            return Ok(());
+        }
+        if let Some(b) = reply.get("build_s").and_then(serde_json::Value::as_f64) {
+            runs.build_ms = b * 1e3;
+        }
+        let trace = reply["trace_s"]
+            .as_f64()
+            .context("no trace_s in the peer's answer")?;
+        runs.trace_ms.push(trace * 1e3);
+        runs.occluded = reply["occluded"].as_u64().unwrap_or(0);
+        Ok(())
+    }
+}
+
+impl Drop for PeerServer {
+    fn drop(&mut self) {
+        // Closing stdin ends the script's loop; a script stuck elsewhere is killed.
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -116,33 +210,42 @@ fn export(case: &Case, dir: &Path) -> anyhow::Result<u64> {
     Ok(rays as u64)
 }
 
-fn ours(case: &Case, repeats: usize) -> anyhow::Result<Ours> {
+fn our_run(case: &Case) -> anyhow::Result<OurRun> {
     let sphere = Lightsphere::new(case.level)?;
-    let params = VisibilityParams::default();
-    let (mut full, mut trace) = (Vec::new(), Vec::new());
-    let mut result = None;
-    for _ in 0..repeats + 1 {
-        let mut engine = VisibilityEngine::cpu(params);
-        let t = Instant::now();
-        let m = engine.compute(&case.scene, &sphere)?;
-        full.push(t.elapsed().as_secs_f64() * 1e3);
-        // The same engine again: the BVH is reused, only the rays are traced.
-        let t = Instant::now();
-        let again = engine.compute(&case.scene, &sphere)?;
-        trace.push(t.elapsed().as_secs_f64() * 1e3);
-        if again.bits() != m.bits() {
-            bail!("{}: the reused BVH changed M", case.name);
-        }
-        result = Some((engine.last_ray_count(), m.visible_count() as u64));
+    let mut engine = VisibilityEngine::cpu(VisibilityParams::default());
+    let t = Instant::now();
+    let m = engine.compute(&case.scene, &sphere)?;
+    let full_ms = t.elapsed().as_secs_f64() * 1e3;
+    // The same engine again: the BVH is reused, only the rays are traced.
+    let t = Instant::now();
+    let again = engine.compute(&case.scene, &sphere)?;
+    let trace_ms = t.elapsed().as_secs_f64() * 1e3;
+    if again.bits() != m.bits() {
+        bail!("{}: the reused BVH changed M", case.name);
     }
-    let (rays, visible) = result.expect("at least one run");
-    // The first run warms caches and the thread pool: left out.
-    Ok(Ours {
+    let rays = engine.last_ray_count();
+    Ok(OurRun {
         rays,
-        occluded: rays - visible,
-        full_ms: median(full[1..].to_vec()),
-        trace_ms: median(trace[1..].to_vec()),
+        occluded: rays - m.visible_count() as u64,
+        full_ms,
+        trace_ms,
     })
+}
+
+/// The median of our time ÷ the peer's over the rounds (both measured within seconds of
+/// each other): (build + trace, trace alone).
+fn ratios(ours: &[OurRun], peer: &PeerRuns) -> (f64, f64) {
+    let total = ours
+        .iter()
+        .zip(&peer.trace_ms)
+        .map(|(o, t)| o.full_ms / (peer.build_ms + t))
+        .collect();
+    let trace = ours
+        .iter()
+        .zip(&peer.trace_ms)
+        .map(|(o, t)| o.trace_ms / t)
+        .collect();
+    (median(total), median(trace))
 }
 
 /// Run the benchmark.
@@ -176,42 +279,43 @@ pub fn run(root: &Path, out: &Path, quick: bool, threads: usize) -> anyhow::Resu
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()?;
+    let mut server = PeerServer::start(&python, root, &dir, threads)?;
+    let peer_names = ["mitsuba3", "open3d"];
     let mut rows = Vec::new();
     for case in &cases {
         let exported = export(case, &dir)?;
-        let o = pool.install(|| ours(case, repeats))?;
-        if o.rays != exported {
-            bail!(
-                "{}: the engine cast {} rays, the export holds {exported}",
-                case.name,
-                o.rays
-            );
+        let (mut ours, mut peers) = (Vec::new(), peer_names.map(|_| PeerRuns::default()));
+        // Round 0 warms caches, the thread pool and the peers' kernels: left out.
+        for round in 0..=repeats {
+            let o = pool.install(|| our_run(case))?;
+            if o.rays != exported {
+                bail!(
+                    "{}: the engine cast {} rays, the export holds {exported}",
+                    case.name,
+                    o.rays
+                );
+            }
+            for (name, runs) in peer_names.iter().zip(&mut peers) {
+                server.round(&case.name, name, runs)?;
+                if round == 0 {
+                    runs.trace_ms.clear();
+                }
+            }
+            if round > 0 {
+                ours.push(o);
+            }
         }
+        let (full, trace) = (
+            median(ours.iter().map(|o| o.full_ms).collect()),
+            median(ours.iter().map(|o| o.trace_ms).collect()),
+        );
         println!(
-            "{}: {} rays, ours {:.1} ms (trace {:.1} ms)",
-            case.name, o.rays, o.full_ms, o.trace_ms
+            "{}: {} rays, ours {full:.1} ms (trace {trace:.1} ms)",
+            case.name, ours[0].rays
         );
-        rows.push(o);
+        rows.push((ours, peers, full, trace));
     }
-    let output = Command::new(&python)
-        .arg(root.join("xtask/scripts/visibility_peers.py"))
-        .arg(&dir)
-        .arg(threads.to_string())
-        .arg(repeats.to_string())
-        .args(cases.iter().map(|c| c.name.as_str()))
-        .env("DRJIT_LIBLLVM_PATH", llvm_path().unwrap_or_default())
-        .output()
-        .context("cannot start the peers' script")?;
-    if !output.status.success() {
-        bail!(
-            "the peers' script failed: {}",
-            String::from_utf8_lossy(&output.stderr)
-        );
-    }
-    let peers: Vec<serde_json::Value> = String::from_utf8_lossy(&output.stdout)
-        .lines()
-        .filter_map(|l| serde_json::from_str(l).ok())
-        .collect();
+    drop(server);
     let mut md = String::new();
     writeln!(
         md,
@@ -220,46 +324,40 @@ pub fn run(root: &Path, out: &Path, quick: bool, threads: usize) -> anyhow::Resu
     writeln!(
         md,
         "Same rays (every receiver vertex towards every lightsphere direction with n·l > 0, origins \
-         pushed 1e-4 × the diagonal along the normal), same triangles, {threads} threads, medians of \
-         {repeats} runs. Ours: a fresh engine (BVH build + trace) and the trace alone (BVH reused). \
-         Peers: scene build and trace. Ratio = our time ÷ the peer's (below 1: faster).\n"
+         pushed 1e-4 × the diagonal along the normal), same triangles, {threads} threads, {repeats} \
+         rounds after a warm-up round, each round one run of ours and then one trace of each peer, \
+         seconds apart. Ours: a fresh engine (BVH build + trace) and the trace alone (BVH reused). \
+         Peers: scene build (once) and trace. Times are medians over the rounds; a ratio is our \
+         time ÷ the peer's in each round, its median over the rounds (below 1: faster).\n"
     )?;
     writeln!(
         md,
         "| case | rays | ours build+trace ms | ours trace ms | Mitsuba 3 build / trace ms | Open3D build / trace ms | ours ÷ Mitsuba (total, trace) | ours ÷ Open3D (total, trace) | occluded: ours / Mitsuba / Open3D |"
     )?;
     writeln!(md, "|---|---|---|---|---|---|---|---|---|")?;
-    for (case, o) in cases.iter().zip(&rows) {
-        let peer = |name: &str| {
-            peers
-                .iter()
-                .find(|p| p["case"] == case.name.as_str() && p["peer"] == name)
-        };
-        let cell = |name: &str| match peer(name) {
-            Some(p) if p.get("error").is_none() => {
-                let (b, t) = (
-                    p["build_s"].as_f64().unwrap_or(f64::NAN) * 1e3,
-                    p["trace_s"].as_f64().unwrap_or(f64::NAN) * 1e3,
-                );
+    for (case, (ours, peers, full, trace)) in cases.iter().zip(&rows) {
+        let cell = |runs: &PeerRuns| match &runs.error {
+            None if !runs.trace_ms.is_empty() => {
+                let (total, traced) = ratios(ours, runs);
                 (
-                    format!("{b:.1} / {t:.1}"),
-                    format!("{:.2}, {:.2}", o.full_ms / (b + t), o.trace_ms / t),
-                    p["occluded"].to_string(),
+                    format!(
+                        "{:.1} / {:.1}",
+                        runs.build_ms,
+                        median(runs.trace_ms.clone())
+                    ),
+                    format!("{total:.2}, {traced:.2}"),
+                    runs.occluded.to_string(),
                 )
             }
-            Some(p) => (
-                "—".into(),
-                format!("({})", p["error"].as_str().unwrap_or("error")),
-                "—".into(),
-            ),
+            Some(e) => ("—".into(), format!("({e})"), "—".into()),
             None => ("—".into(), "—".into(), "—".into()),
         };
-        let (mi_t, mi_r, mi_o) = cell("mitsuba3");
-        let (o3_t, o3_r, o3_o) = cell("open3d");
+        let (mi_t, mi_r, mi_o) = cell(&peers[0]);
+        let (o3_t, o3_r, o3_o) = cell(&peers[1]);
         writeln!(
             md,
-            "| {} | {} | {:.1} | {:.1} | {mi_t} | {o3_t} | {mi_r} | {o3_r} | {} / {mi_o} / {o3_o} |",
-            case.name, o.rays, o.full_ms, o.trace_ms, o.occluded
+            "| {} | {} | {full:.1} | {trace:.1} | {mi_t} | {o3_t} | {mi_r} | {o3_r} | {} / {mi_o} / {o3_o} |",
+            case.name, ours[0].rays, ours[0].occluded
         )?;
     }
     atomic_out::write_bytes(&out.join("bench-visibility.md"), md.as_bytes())?;
