@@ -13,7 +13,8 @@
 //! * [`CpuMethod::Packets`]: the rays of one chunk towards one direction l_j are parallel and
 //!   start close together, so they walk a binary BVH together: a node is skipped outright when
 //!   no ray of the family o + t·l_j (o in the chunk's origin box) can meet it, otherwise each
-//!   live ray of a 64-bit mask is slab-tested; a ray leaves the mask at its first hit. This is
+//!   live ray of a 64-bit mask is slab-tested (eight per instruction where the CPU has AVX2,
+//!   the `packets` module); a ray leaves the mask at its first hit. This is
 //!   the CPU counterpart of the seed's per-direction pass (paper 000 §3.2), without its
 //!   resolution limit.
 //! * [`CpuMethod::Fans`]: the rays of one vertex share its origin, so its directions walk
@@ -37,7 +38,12 @@
 //! fans 43.6 / 52.8 / 91.6 / 226 / 681 ms. (An earlier session, its day: packets 43.3 / 67.9
 //! / 173 / 571 / 2,062, fans 49.4 / 56.0 / 92.4 / 221 / 614; at the start: fans 427
 //! / 1,171 ms at k = 258 / 1026.) With few directions a vertex's fan is nearly empty and the
-//! per-fan set-up dominates; with many, the shared origin pays. Same M: at k = 258 no entry
+//! per-fan set-up dominates; with many, the shared origin pays. Since the packets test eight
+//! rays per instruction (2026-12-06, a slower day; the same measure, medians of 9 in each of
+//! three alternated rounds): packets 48.2–56.5 / 72.4–87.5 / 222–226 ms at k = 6 / 18 / 66
+//! against 57.5–60.3 / 97.9–120 / 304–329 for the scalar packets of the round before and
+//! 71.5–77.4 / 94.8–102 / 146–163 for the fans: the packets now win at k = 18 as well, and
+//! [`FAN_MIN_COLUMNS`] moved from 12 to 32. Same M: at k = 258 no entry
 //! of the 9.3 M differs between packets and fans, at k = 1026 4 of 36.9 M (edge-grazing
 //! rays); neither changes with the build preset (M's hash checked).
 //!
@@ -188,18 +194,19 @@ pub enum CpuMethod {
     /// default: the faster of the two on either side).
     #[default]
     Auto,
-    /// Packets of up to 64 parallel rays through a binary BVH (faster for k ≤ 6).
+    /// Packets of up to 64 parallel rays through a binary BVH (faster for k ≤ 18).
     Packets,
     /// One traversal per ray of an 8-wide compressed BVH, with a shadow cache.
     SingleRays,
     /// Fans: each vertex's directions in fans of up to 64 from its origin (faster for
-    /// k ≥ 18).
+    /// k ≥ 66).
     Fans,
 }
 
-/// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 6 (packets
-/// 1.26× faster) and k = 18 (fans 1.20× faster).
-pub const FAN_MIN_COLUMNS: usize = 12;
+/// Columns from which [`CpuMethod::Auto`] takes fans: between the bunny's k = 18 (packets
+/// 1.17× faster, BVH build included, the median of three rounds) and k = 66 (fans 1.39×
+/// faster); the ratios, interpolated in log k, cross at about 27.
+pub const FAN_MIN_COLUMNS: usize = 32;
 
 impl CpuMethod {
     /// The traversal this method runs for a call computing `columns` columns.

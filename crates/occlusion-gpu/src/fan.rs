@@ -371,8 +371,8 @@ impl FanSetup {
     }
 }
 
-/// Whether this CPU runs AVX2 (the eight-lane fan traversal).
-fn has_avx2() -> bool {
+/// Whether this CPU runs AVX2 (the eight-lane fan and packet traversals).
+pub(crate) fn has_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         std::is_x86_feature_detected!("avx2")
@@ -381,6 +381,15 @@ fn has_avx2() -> bool {
     {
         false
     }
+}
+
+/// Bit 8g set for every group g of eight lanes with a lane in `mask`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn live_wide(mask: u64) -> u64 {
+    let m = mask | mask >> 1;
+    let m = m | m >> 2;
+    (m | m >> 4) & 0x0101_0101_0101_0101
 }
 
 /// Bit 4g set for every group g of four lanes with a lane in `mask`.
@@ -762,4 +771,4 @@ fn triangle_lanes<const BOUNDED: bool>(
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]
-mod tests;
+pub(crate) mod tests;

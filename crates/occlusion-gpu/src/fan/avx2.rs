@@ -17,6 +17,7 @@ use glam::{Vec3A, Vec4};
 
 use super::{
     ALONE, FanNode, FanSetup, FanTracer, FanTriangle, GROUPS, Packed, RayFan, Stacks, lanes_alone,
+    live_wide,
 };
 use crate::cpu::EDGE_TOLERANCE;
 
@@ -24,14 +25,6 @@ use crate::cpu::EDGE_TOLERANCE;
 const WIDE: usize = 8;
 /// Groups of eight lanes per fan.
 const WIDE_GROUPS: usize = super::FAN_SIZE / WIDE;
-
-/// Bit 8g set for every group g of eight lanes with a lane in `mask`.
-#[inline(always)]
-fn live_wide(mask: u64) -> u64 {
-    let m = mask | mask >> 1;
-    let m = m | m >> 2;
-    (m | m >> 4) & 0x0101_0101_0101_0101
-}
 
 /// Eight-lane groups of one coordinate (`[Vec4; 16]` seen as `[[f32; 8]; 8]`).
 fn widen(lanes: &[Vec4; GROUPS]) -> [__m256; WIDE_GROUPS] {

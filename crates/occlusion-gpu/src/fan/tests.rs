@@ -7,8 +7,8 @@ use super::{FanTracer, Packed, PreparedDirections, RayFan, Stacks, fan_groups};
 use crate::scene::{Prepared, Scene};
 
 /// A crumpled sheet: a 40 × 40 grid with pseudo-random heights, so rays from it graze,
-/// hit and escape in every proportion.
-fn crumpled() -> Scene {
+/// hit and escape in every proportion (the packets' AVX2 test reads it too).
+pub(crate) fn crumpled() -> Scene {
     let n = 40u32;
     let mut state = 0x2545_f491_u32;
     let mut noise = || {
