@@ -14,6 +14,25 @@
 //! (`benches/deforming.rs`, one run, medians): drape k = 258 23.7 ms refitting against
 //! 27.3 ms rebuilding, k = 66 10.1 vs 12.6; the chicken at k = 258 19.8 vs 22.1, k = 66 7.1
 //! vs 9.6.
+//!
+//! Tried and dropped (2026-12-06, the drape at k = 258 with its ball, 9,730 triangles):
+//!
+//! * obvhs's reinsertion after each refit (`ReinsertionOptimizer` on 2 % and 10 % of the
+//!   nodes, then the depth-first renumbering of [`padded_bvh2`]). Over 120 frames, refitting
+//!   always (a rebuild only past SAH 1.5: 4 builds), four alternated rounds: 33.6 / 38.9 /
+//!   33.2 / 35.1 ms of trace per frame against 34.6 / 38.8 / 32.8 / 36.4 without, and
+//!   0.3–0.6 ms more per refit. Fresh trees traced in 27.7–32.8 ms in the same rounds. The
+//!   reinsertion moved the SAH ratio by under 0.3 % (1.1246 before, 1.1246 after, on a late
+//!   frame): a refitted tree loses its speed in its leaves (triangles grouped for another
+//!   frame's shape), not in where its subtrees hang.
+//! * `very_fast_build` (no search radius, 1 % reinsertion) for the fans' tree, which a
+//!   deforming mesh rebuilds often. Its build is 0.6–0.8 ms cheaper (drape 2.7–2.8 against
+//!   3.4–3.5 ms), but its trees trace slower. With the engine's refit rule (`benches/
+//!   deforming.rs`, two alternated rounds) the drape took 31.3 / 30.4 ms per frame against
+//!   29.8 / 29.3 with `fast_build`, the chicken at k = 258 27.2 / 27.2 against 25.4 / 24.6.
+//!   Running obvhs's build on one thread instead of two (rayon's overhead on 8,450 triangles:
+//!   2.0 ms alone against 2.7–2.8) gained nothing inside the engine (4.3–4.5 ms per build
+//!   against 3.7–4.5).
 
 use std::time::Duration;
 
@@ -143,9 +162,9 @@ pub(crate) fn refit_tree<T>(
 
 /// A binary BVH (`obvhs`'s PLOC build with `quality`'s settings, at most `leaf_size` triangles
 /// per leaf) over the scene's triangles, with every box padded a little so that the slab test
-/// never drops a ray that the triangle test (with its [`crate::cpu::EDGE_TOLERANCE`]) counts as a hit on
-/// the box's boundary; the triangles come back in leaf order. Empty for a scene without
-/// triangles.
+/// never drops a ray that the triangle test (with its [`crate::cpu::EDGE_TOLERANCE`]) counts
+/// as a hit on the box's boundary; the triangles come back in leaf order. Empty for a scene
+/// without triangles.
 pub(crate) fn padded_bvh2(
     prepared: &Prepared,
     quality: BvhBuildParams,
