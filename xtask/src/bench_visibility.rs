@@ -10,10 +10,12 @@
 //! n·l > 0 — and the triangle soup in the engine's centred coordinates are written as `.npy`
 //! under `target/bench-visibility/`; `xtask/scripts/visibility_peers.py` traces them in a
 //! virtual environment under `target/mitsuba-venv` (Mitsuba and Open3D are comparisons, not
-//! dependencies), served one trace per request so that each round runs ours and then each peer
-//! within seconds. Ours: a fresh engine per run (BVH build + trace, as a deforming frame pays)
-//! and, on the same engine, the trace alone (the BVH reused). Peers: scene build (once) and
-//! trace apart. Times are medians over the rounds, and each ratio is the median of the rounds'
+//! dependencies), served one build and trace per request so that each round runs ours and then
+//! each peer within seconds. Ours: a fresh engine per run (BVH build + trace, as a deforming
+//! frame pays) and, on the same engine, the trace alone (the BVH reused). Peers: a fresh scene
+//! build and a trace per round (measured once per case before, which left Open3D's lazy build
+//! anywhere from 5 to 374 ms within one run). Times are medians over the rounds, and each ratio
+//! is the median of the rounds'
 //! own ratios: this machine's speed drifts by up to a quarter within minutes (the bunny's trace
 //! at k = 258 took 0.25–0.37 s in one session, the code unchanged), and before the rounds
 //! alternated our runs and the peers' came minutes apart (the ratio moved from 0.72 to 0.83
@@ -47,16 +49,16 @@ struct OurRun {
     trace_ms: f64,
 }
 
-/// What one peer measured on one case: its build once, a trace per round.
+/// What one peer measured on one case: a fresh build and a trace per round.
 #[derive(Default)]
 struct PeerRuns {
-    build_ms: f64,
+    build_ms: Vec<f64>,
     trace_ms: Vec<f64>,
     occluded: u64,
     error: Option<String>,
 }
 
-/// The peers' script, serving one trace per request (`xtask/scripts/visibility_peers.py`).
+/// The peers' script, serving one build and trace per request (`xtask/scripts/visibility_peers.py`).
 struct PeerServer {
     child: Child,
     stdin: ChildStdin,
@@ -91,7 +93,7 @@ impl PeerServer {
         })
     }
 
-    /// One trace of `peer` on `case` (its scene built on the first request).
+    /// One round of `peer` on `case`: a fresh build and a trace.
     fn ask(&mut self, case: &str, peer: &str) -> anyhow::Result<serde_json::Value> {
         writeln!(self.stdin, "{case} {peer}").context("the peers' script stopped reading")?;
         self.stdin.flush()?;
@@ -113,13 +115,13 @@ impl PeerServer {
             runs.error = Some(e.as_str().unwrap_or("error").to_owned());
             return Ok(());
         }
-        if let Some(b) = reply.get("build_s").and_then(serde_json::Value::as_f64) {
-            runs.build_ms = b * 1e3;
-        }
-        let trace = reply["trace_s"]
-            .as_f64()
-            .context("no trace_s in the peer's answer")?;
-        runs.trace_ms.push(trace * 1e3);
+        let seconds = |key: &str| {
+            reply[key]
+                .as_f64()
+                .with_context(|| format!("no {key} in the peer's answer {reply}"))
+        };
+        runs.build_ms.push(seconds("build_s")? * 1e3);
+        runs.trace_ms.push(seconds("trace_s")? * 1e3);
         runs.occluded = reply["occluded"].as_u64().unwrap_or(0);
         Ok(())
     }
@@ -237,8 +239,8 @@ fn our_run(case: &Case) -> anyhow::Result<OurRun> {
 fn ratios(ours: &[OurRun], peer: &PeerRuns) -> (f64, f64) {
     let total = ours
         .iter()
-        .zip(&peer.trace_ms)
-        .map(|(o, t)| o.full_ms / (peer.build_ms + t))
+        .zip(peer.build_ms.iter().zip(&peer.trace_ms))
+        .map(|(o, (b, t))| o.full_ms / (b + t))
         .collect();
     let trace = ours
         .iter()
@@ -298,6 +300,7 @@ pub fn run(root: &Path, out: &Path, quick: bool, threads: usize) -> anyhow::Resu
             for (name, runs) in peer_names.iter().zip(&mut peers) {
                 server.round(&case.name, name, runs)?;
                 if round == 0 {
+                    runs.build_ms.clear();
                     runs.trace_ms.clear();
                 }
             }
@@ -325,9 +328,9 @@ pub fn run(root: &Path, out: &Path, quick: bool, threads: usize) -> anyhow::Resu
         md,
         "Same rays (every receiver vertex towards every lightsphere direction with n·l > 0, origins \
          pushed 1e-4 × the diagonal along the normal), same triangles, {threads} threads, {repeats} \
-         rounds after a warm-up round, each round one run of ours and then one trace of each peer, \
+         rounds after a warm-up round, each round one run of ours and then one build and trace of each peer, \
          seconds apart. Ours: a fresh engine (BVH build + trace) and the trace alone (BVH reused). \
-         Peers: scene build (once) and trace. Times are medians over the rounds; a ratio is our \
+         Peers: a fresh scene build and a trace per round. Times are medians over the rounds; a ratio is our \
          time ÷ the peer's in each round, its median over the rounds (below 1: faster).\n"
     )?;
     writeln!(
@@ -342,7 +345,7 @@ pub fn run(root: &Path, out: &Path, quick: bool, threads: usize) -> anyhow::Resu
                 (
                     format!(
                         "{:.1} / {:.1}",
-                        runs.build_ms,
+                        median(runs.build_ms.clone()),
                         median(runs.trace_ms.clone())
                     ),
                     format!("{total:.2}, {traced:.2}"),
