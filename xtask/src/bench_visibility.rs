@@ -15,13 +15,12 @@
 //! frame pays) and, on the same engine, the trace alone (the BVH reused). Peers: a fresh scene
 //! build and a trace per round (measured once per case before, which left Open3D's lazy build
 //! anywhere from 5 to 374 ms within one run). Times are medians over the rounds, and each ratio
-//! is the median of the rounds'
-//! own ratios: this machine's speed drifts by up to a quarter within minutes (the bunny's trace
-//! at k = 258 took 0.25–0.37 s in one session, the code unchanged), and before the rounds
-//! alternated our runs and the peers' came minutes apart (the ratio moved from 0.72 to 0.83
-//! between two days). The occluded-ray counts are compared as a cross-check. Writes
-//! `target/repro/bench-visibility.md`. Open3D's wheel needs `libusb-1.0-0` (Debian); a peer that
-//! cannot be imported is reported in its column, not fatal.
+//! is the median of the rounds' own ratios: this machine's speed drifts by up to a quarter
+//! within minutes (the bunny's trace at k = 258 took 0.25–0.37 s in one session, the code
+//! unchanged), and before the rounds alternated our runs and the peers' came minutes apart (the
+//! ratio moved from 0.72 to 0.83 between two days). The occluded-ray counts are compared as a
+//! cross-check. Writes `target/repro/bench-visibility.md`. Open3D's wheel needs `libusb-1.0-0`
+//! (Debian); a peer that cannot be imported is reported in its column, not fatal.
 
 use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Write as _};
@@ -58,7 +57,8 @@ struct PeerRuns {
     error: Option<String>,
 }
 
-/// The peers' script, serving one build and trace per request (`xtask/scripts/visibility_peers.py`).
+/// The peers' script (`xtask/scripts/visibility_peers.py`), serving one build and trace per
+/// request.
 struct PeerServer {
     child: Child,
     stdin: ChildStdin,
