@@ -48,11 +48,14 @@ struct OurRun {
     trace_ms: f64,
 }
 
-/// What one peer measured on one case: a fresh build and a trace per round.
+/// What one peer measured on one case: a fresh build and a trace per round, and the round's
+/// total (build + trace, or as the peer timed it in one piece: Open3D's creation and first
+/// query).
 #[derive(Default)]
 struct PeerRuns {
     build_ms: Vec<f64>,
     trace_ms: Vec<f64>,
+    total_ms: Vec<f64>,
     occluded: u64,
     error: Option<String>,
 }
@@ -120,8 +123,11 @@ impl PeerServer {
                 .as_f64()
                 .with_context(|| format!("no {key} in the peer's answer {reply}"))
         };
-        runs.build_ms.push(seconds("build_s")? * 1e3);
-        runs.trace_ms.push(seconds("trace_s")? * 1e3);
+        let (build, trace) = (seconds("build_s")? * 1e3, seconds("trace_s")? * 1e3);
+        let total = reply["total_s"].as_f64().map_or(build + trace, |t| t * 1e3);
+        runs.build_ms.push(build);
+        runs.trace_ms.push(trace);
+        runs.total_ms.push(total);
         runs.occluded = reply["occluded"].as_u64().unwrap_or(0);
         Ok(())
     }
@@ -239,8 +245,8 @@ fn our_run(case: &Case) -> anyhow::Result<OurRun> {
 fn ratios(ours: &[OurRun], peer: &PeerRuns) -> (f64, f64) {
     let total = ours
         .iter()
-        .zip(peer.build_ms.iter().zip(&peer.trace_ms))
-        .map(|(o, (b, t))| o.full_ms / (b + t))
+        .zip(&peer.total_ms)
+        .map(|(o, t)| o.full_ms / t)
         .collect();
     let trace = ours
         .iter()
@@ -302,6 +308,7 @@ pub fn run(root: &Path, out: &Path, quick: bool, threads: usize) -> anyhow::Resu
                 if round == 0 {
                     runs.build_ms.clear();
                     runs.trace_ms.clear();
+                    runs.total_ms.clear();
                 }
             }
             if round > 0 {
